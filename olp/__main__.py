@@ -1,0 +1,7 @@
+"""``python -m olp`` is the ``olp`` command."""
+
+import sys
+
+from olp.cli import main
+
+sys.exit(main())

@@ -1,0 +1,91 @@
+"""Errors for bad *input*: every one knows where in which file it happened.
+
+Bad programs (unreachable targets, limits, collisions) are not errors but diagnostics
+(:mod:`olp.diagnostics`). An :class:`OlpError` means olp could not read or understand its input,
+or was used wrongly; the CLI turns it into exit code 2 and a located message.
+"""
+
+from __future__ import annotations
+
+from olp.ir import SourceSpan
+
+
+class OlpError(Exception):
+    """Base of all olp input errors.
+
+    Parameters
+    ----------
+    message:
+        What was expected and what was found.
+    span:
+        Where, if known.
+    source_line:
+        The text of the offending line, for the caret display.
+    hint:
+        Optional advice for the user.
+    """
+
+    kind = "error"
+
+    def __init__(
+        self,
+        message: str,
+        span: SourceSpan | None = None,
+        source_line: str | None = None,
+        hint: str | None = None,
+    ) -> None:
+        super().__init__(message)
+        self.message = message
+        self.span = span
+        self.source_line = source_line
+        self.hint = hint
+
+    def format(self) -> str:
+        """The message in compiler style: ``file:line:col: error: message``, line and caret."""
+        where = f"{self.span}: " if self.span is not None else ""
+        lines = [f"{where}{self.kind}: {self.message}"]
+        if self.source_line is not None and self.span is not None:
+            text = self.source_line.rstrip("\r\n").expandtabs(1)
+            lines.append(f"    {text}")
+            start = max(self.span.column - 1, 0)
+            width = 1
+            if self.span.end_line == self.span.line and self.span.end_column is not None:
+                width = max(self.span.end_column - self.span.column, 1)
+            width = max(1, min(width, len(text) - start)) if start < len(text) else 1
+            lines.append("    " + " " * start + "^" * width)
+        if self.hint:
+            lines.append(f"    hint: {self.hint}")
+        return "\n".join(lines)
+
+    def __str__(self) -> str:
+        return self.format()
+
+
+class ParseError(OlpError):
+    """A program file could not be read (syntax, unknown statement, bad value)."""
+
+    kind = "parse error"
+
+
+class StationError(OlpError):
+    """A station file (YAML, URDF, robot library entry) is invalid."""
+
+    kind = "station error"
+
+
+class PostError(OlpError):
+    """A post-processor folder or template is invalid, or cannot express the program."""
+
+    kind = "post error"
+
+
+class UsageError(OlpError):
+    """olp was called wrongly (unknown post, missing file, bad option)."""
+
+    kind = "usage error"
+
+
+def line_of(text: str, line: int) -> str | None:
+    """The 1-based ``line`` of ``text``, or None if out of range."""
+    lines = text.splitlines()
+    return lines[line - 1] if 1 <= line <= len(lines) else None

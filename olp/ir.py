@@ -1,0 +1,372 @@
+"""The intermediate representation: what a robot program *means*, in SI units.
+
+Every frontend lowers to these frozen dataclasses and every post renders from them (through
+:class:`olp.passes.resolve.CompiledProgram`). The IR never says how one vendor spells a thing.
+
+Conventions
+-----------
+* Lengths in metres, angles in radians, time in seconds, speeds in m/s and rad/s.
+* Poses are ``(4, 4)`` float64 homogeneous transforms (read-only arrays).
+* A Cartesian target is the pose of the **TCP** in its motion's **frame**.
+* A frame's pose is given in the station's world frame; a tool's pose is the TCP in the robot's
+  flange frame (the vendor's flange convention, see :mod:`olp.vendors`).
+* Joint values are in the controller's convention (what the pendant shows), in radians.
+* Every motion carries the speed, zone, tool and frame it runs with, so a program is a plain
+  sequence that can be edited as data (``dataclasses.replace``) without a state machine.
+
+Fields are keyword-only: ``LinearMove(target=..., speed=..., span=...)``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass, field
+from typing import Any, Literal, TypeAlias, TypeGuard
+
+import numpy as np
+from numpy.typing import NDArray
+
+FloatArray: TypeAlias = NDArray[np.float64]
+
+
+class IRError(ValueError):
+    """An IR object was constructed with invalid values (a programming error in a frontend)."""
+
+
+def _frozen_array(value: Any, shape: tuple[int, ...] | None, what: str) -> FloatArray:
+    arr = np.array(value, dtype=np.float64)
+    if shape is not None and arr.shape != shape:
+        raise IRError(f"{what}: expected shape {shape}, got {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise IRError(f"{what}: values must be finite, got {arr.tolist()}")
+    arr.setflags(write=False)
+    return arr
+
+
+def _fields_equal(a: Any, b: Any) -> bool:
+    if type(a) is not type(b):
+        return NotImplemented
+    for f in dataclasses.fields(a):
+        x, y = getattr(a, f.name), getattr(b, f.name)
+        if isinstance(x, np.ndarray) or isinstance(y, np.ndarray):
+            if not (isinstance(x, np.ndarray) and isinstance(y, np.ndarray)):
+                return False
+            if x.shape != y.shape or not np.array_equal(x, y):
+                return False
+        elif x != y:
+            return False
+    return True
+
+
+def _array_eq(cls: type) -> type:
+    """Give a dataclass holding numpy arrays a value equality (and no hash)."""
+    cls.__eq__ = _fields_equal  # type: ignore[assignment]
+    cls.__hash__ = None  # type: ignore[assignment]
+    return cls
+
+
+@dataclass(frozen=True, slots=True)
+class SourceSpan:
+    """Where something came from: 1-based line and column (end exclusive, optional)."""
+
+    file: str
+    line: int
+    column: int = 1
+    end_line: int | None = None
+    end_column: int | None = None
+
+    def __str__(self) -> str:
+        return f"{self.file}:{self.line}:{self.column}"
+
+    @property
+    def location(self) -> str:
+        """``file:line``, the form used in reports."""
+        return f"{self.file}:{self.line}"
+
+
+GENERATED = SourceSpan("<generated>", 0, 0)
+"""Span for instructions made by a transform rather than read from a file."""
+
+
+# --------------------------------------------------------------------------------------------
+# Targets, tools, frames, speeds, zones
+
+
+@dataclass(frozen=True, slots=True)
+class Configuration:
+    """A vendor-neutral robot configuration request for a Cartesian target.
+
+    ``shoulder``: wrist centre in front of (``"front"``) or behind (``"back"``) axis 1.
+    ``elbow``: ``"up"`` or ``"down"``. ``wrist``: ``"flip"`` when the wrist-bend axis (axis 5) is
+    negative in the controller's convention, else ``"noflip"``.
+    ``joint_ranges``: per joint, ``None`` or a half-open interval ``(low, high)`` in radians that
+    the joint value must lie in; this expresses KUKA Turn bits, ABB cf1/cf4/cf6 quadrants and
+    Fanuc turn numbers alike. Vendor modules translate their own encodings to and from this.
+    """
+
+    shoulder: Literal["front", "back"] | None = None
+    elbow: Literal["up", "down"] | None = None
+    wrist: Literal["flip", "noflip"] | None = None
+    joint_ranges: tuple[tuple[float, float] | None, ...] | None = None
+
+
+@_array_eq
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class JointTarget:
+    """Joint values in radians, controller convention, one per robot axis."""
+
+    joints: FloatArray
+    name: str | None = None
+
+    def __post_init__(self) -> None:
+        joints = _frozen_array(self.joints, None, "JointTarget.joints")
+        if joints.ndim != 1 or joints.size == 0:
+            raise IRError(f"JointTarget.joints: expected a 1-D array, got shape {joints.shape}")
+        object.__setattr__(self, "joints", joints)
+
+
+@_array_eq
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class CartesianTarget:
+    """A TCP pose (4, 4) in metres in the motion's frame, with an optional configuration."""
+
+    pose: FloatArray
+    config: Configuration | None = None
+    name: str | None = None
+
+    def __post_init__(self) -> None:
+        pose = _frozen_array(self.pose, (4, 4), "CartesianTarget.pose")
+        _check_rigid(pose, "CartesianTarget.pose")
+        object.__setattr__(self, "pose", pose)
+
+
+Target: TypeAlias = JointTarget | CartesianTarget
+
+
+def _check_rigid(pose: FloatArray, what: str) -> None:
+    rot = pose[:3, :3]
+    if not np.allclose(rot @ rot.T, np.eye(3), atol=1e-6) or np.linalg.det(rot) < 0:
+        raise IRError(f"{what}: rotation part is not a proper rotation matrix")
+    if not np.array_equal(pose[3], [0.0, 0.0, 0.0, 1.0]):
+        raise IRError(f"{what}: last row must be [0, 0, 0, 1]")
+
+
+@_array_eq
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class Tool:
+    """A tool: the TCP pose (4, 4) in the flange frame, metres.
+
+    ``pose=None`` is a reference to be looked up in the station by ``name`` (or ``number``).
+    """
+
+    name: str
+    pose: FloatArray | None = None
+    number: int | None = None
+
+    def __post_init__(self) -> None:
+        if self.pose is not None:
+            pose = _frozen_array(self.pose, (4, 4), f"Tool {self.name!r} pose")
+            _check_rigid(pose, f"Tool {self.name!r} pose")
+            object.__setattr__(self, "pose", pose)
+
+
+@_array_eq
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class Frame:
+    """A user frame (base, work object): its pose (4, 4) in the station's world frame, metres.
+
+    ``pose=None`` is a reference to be looked up in the station by ``name`` (or ``number``).
+    """
+
+    name: str
+    pose: FloatArray | None = None
+    number: int | None = None
+
+    def __post_init__(self) -> None:
+        if self.pose is not None:
+            pose = _frozen_array(self.pose, (4, 4), f"Frame {self.name!r} pose")
+            _check_rigid(pose, f"Frame {self.name!r} pose")
+            object.__setattr__(self, "pose", pose)
+
+
+WORLD = Frame(name="world", pose=np.eye(4), number=0)
+"""The station's world frame."""
+
+FLANGE = Tool(name="flange", pose=np.eye(4), number=0)
+"""No tool: the TCP is the flange."""
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Speed:
+    """Programmed speeds.
+
+    ``linear``: TCP speed for linear/circular moves, m/s.
+    ``joint``: fraction (0, 1] of each axis' maximum velocity for joint moves.
+    ``angular``: optional TCP orientation speed limit for linear/circular moves, rad/s.
+    ``joint_acceleration``: fraction (0, 1] of each axis' maximum acceleration.
+    """
+
+    linear: float = 0.25
+    joint: float = 1.0
+    angular: float | None = None
+    joint_acceleration: float = 1.0
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.linear) and self.linear > 0):
+            raise IRError(f"Speed.linear must be > 0 m/s, got {self.linear}")
+        for name in ("joint", "joint_acceleration"):
+            value = getattr(self, name)
+            if not (np.isfinite(value) and 0 < value <= 1):
+                raise IRError(f"Speed.{name} must be in (0, 1], got {value}")
+        if self.angular is not None and not (np.isfinite(self.angular) and self.angular > 0):
+            raise IRError(f"Speed.angular must be > 0 rad/s, got {self.angular}")
+
+
+@dataclass(frozen=True, slots=True)
+class Zone:
+    """End-of-move blending: ``radius`` in metres; 0 is a fine (exact) stop."""
+
+    radius: float = 0.0
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.radius) and self.radius >= 0):
+            raise IRError(f"Zone.radius must be >= 0 m, got {self.radius}")
+
+    @property
+    def is_fine(self) -> bool:
+        return self.radius == 0.0
+
+
+FINE = Zone(0.0)
+
+
+# --------------------------------------------------------------------------------------------
+# Instructions
+
+
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class _Motion:
+    target: Target
+    speed: Speed = field(default_factory=Speed)
+    zone: Zone = FINE
+    tool: Tool = field(default_factory=lambda: FLANGE)
+    frame: Frame = field(default_factory=lambda: WORLD)
+    span: SourceSpan = GENERATED
+
+
+@_array_eq
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class JointMove(_Motion):
+    """Move in joint space (KUKA PTP, ABB MoveJ/MoveAbsJ, UR movej, Fanuc J)."""
+
+    kind: Literal["joint"] = field(default="joint", init=False)
+
+
+@_array_eq
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class LinearMove(_Motion):
+    """Move the TCP on a straight line (KUKA LIN, ABB MoveL, UR movel, Fanuc L)."""
+
+    kind: Literal["linear"] = field(default="linear", init=False)
+
+
+@_array_eq
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class CircularMove(_Motion):
+    """Move the TCP on the circle through ``via`` to ``target`` (KUKA CIRC, ABB MoveC ...)."""
+
+    via: CartesianTarget
+    kind: Literal["circular"] = field(default="circular", init=False)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Wait:
+    """Dwell for ``seconds``."""
+
+    seconds: float
+    span: SourceSpan = GENERATED
+    kind: Literal["wait"] = field(default="wait", init=False)
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.seconds) and self.seconds >= 0):
+            raise IRError(f"Wait.seconds must be >= 0, got {self.seconds}")
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class SetOutput:
+    """Set digital output ``index`` to ``value``."""
+
+    index: int
+    value: bool
+    span: SourceSpan = GENERATED
+    kind: Literal["set_output"] = field(default="set_output", init=False)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class WaitInput:
+    """Wait until digital input ``index`` equals ``value``."""
+
+    index: int
+    value: bool = True
+    span: SourceSpan = GENERATED
+    kind: Literal["wait_input"] = field(default="wait_input", init=False)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Call:
+    """Call a subprogram or controller routine by name (e.g. ``SprayOn``)."""
+
+    name: str
+    args: tuple[str, ...] = ()
+    span: SourceSpan = GENERATED
+    kind: Literal["call"] = field(default="call", init=False)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Comment:
+    """A comment kept in the output."""
+
+    text: str
+    span: SourceSpan = GENERATED
+    kind: Literal["comment"] = field(default="comment", init=False)
+
+
+Motion: TypeAlias = JointMove | LinearMove | CircularMove
+Instruction: TypeAlias = (
+    JointMove | LinearMove | CircularMove | Wait | SetOutput | WaitInput | Call | Comment
+)
+
+MOTION_TYPES = (JointMove, LinearMove, CircularMove)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Program:
+    """A named sequence of instructions read from ``source``."""
+
+    name: str
+    instructions: tuple[Instruction, ...]
+    source: str = "<memory>"
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.instructions, tuple):
+            object.__setattr__(self, "instructions", tuple(self.instructions))
+
+    def __iter__(self) -> Iterator[Instruction]:
+        return iter(self.instructions)
+
+    def __len__(self) -> int:
+        return len(self.instructions)
+
+    def motions(self) -> Iterator[Motion]:
+        """The motion instructions, in order."""
+        return (i for i in self.instructions if isinstance(i, MOTION_TYPES))
+
+    def replace_instructions(self, instructions: Sequence[Instruction]) -> Program:
+        """A copy with other instructions (for IR -> IR transforms)."""
+        return dataclasses.replace(self, instructions=tuple(instructions))
+
+
+def is_motion(instruction: Instruction) -> TypeGuard[Motion]:
+    """True for joint, linear and circular moves."""
+    return isinstance(instruction, MOTION_TYPES)

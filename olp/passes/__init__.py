@@ -1,0 +1,1 @@
+"""Compiler passes: resolve (targets to joints), check, timing. Each is a plain function."""

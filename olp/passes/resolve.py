@@ -1,0 +1,351 @@
+"""Resolve: every motion's target to joint values, on the station, with diagnostics.
+
+* Tool and frame references are looked up in the station (inline definitions pass through).
+* A joint target is taken as given and checked against the joint limits.
+* A Cartesian target of a joint move takes the IK solution (any branch, any ±360° turn variant
+  inside the limits) nearest to the previous joints.
+* A linear move must stay in one IK branch: the straight TCP line is sampled (``step_m``,
+  ``step_rad``), solved in the branch of the start joints and unwrapped continuously. Leaving the
+  workspace, a joint limit, or a joint jump between samples (a singularity or a configuration
+  flip) is an error on that instruction.
+
+The result is a :class:`CompiledProgram`: the program, one :class:`Step` per instruction (end
+joints, resolved tool and frame, sampled joint path of a motion) and the diagnostics.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from olp.diagnostics import Diagnostic, has_errors
+from olp.geometry import interpolate_poses, inv, pose_distance
+from olp.ir import (
+    MOTION_TYPES,
+    CartesianTarget,
+    CircularMove,
+    Frame,
+    Instruction,
+    JointMove,
+    JointTarget,
+    LinearMove,
+    Program,
+    Tool,
+    is_motion,
+)
+from olp.kinematics.opw import turn_variants
+from olp.station.model import Robot, Station
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True, slots=True)
+class ResolveOptions:
+    """Settings of the resolve pass.
+
+    ``step_m`` / ``step_rad``: sampling of linear moves (TCP travel and rotation per sample).
+    ``max_joint_step_rad``: a larger joint change between two samples is reported as a
+    discontinuity (singularity or configuration flip). ``weights``: per-joint weights of the
+    distance used to choose the nearest IK solution.
+    """
+
+    step_m: float = 0.005
+    step_rad: float = np.radians(2.0)
+    max_joint_step_rad: float = np.radians(15.0)
+    weights: tuple[float, ...] = (1.0, 1.0, 1.0, 1.0, 1.0, 1.0)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Step:
+    """One instruction as compiled.
+
+    ``joints``: joints at the end of a motion, (6,) rad; ``path``: the sampled joint path of a
+    motion including its start, (S, 6) rad; ``duration`` (s) and ``path_length`` (m of TCP travel)
+    are filled by the timing pass.
+    """
+
+    index: int
+    instruction: Instruction
+    joints: FloatArray | None = None
+    path: FloatArray | None = None
+    tool: Tool | None = None
+    frame: Frame | None = None
+    duration: float = 0.0
+    path_length: float = 0.0
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class CompiledProgram:
+    """A program resolved on a station: steps (one per instruction) and diagnostics."""
+
+    program: Program
+    station: Station
+    start_joints: FloatArray
+    steps: tuple[Step, ...]
+    diagnostics: tuple[Diagnostic, ...] = field(default=())
+
+    @property
+    def ok(self) -> bool:
+        """No error diagnostics: code may be written."""
+        return not has_errors(self.diagnostics)
+
+    @property
+    def cycle_time(self) -> float:
+        """Total estimated time, seconds."""
+        return float(sum(s.duration for s in self.steps))
+
+    def motion_steps(self) -> list[Step]:
+        return [s for s in self.steps if is_motion(s.instruction)]
+
+
+def resolve(
+    program: Program, station: Station, options: ResolveOptions | None = None
+) -> CompiledProgram:
+    """Resolve every motion of ``program`` on ``station``; never raises on a bad program."""
+    opts = options or ResolveOptions()
+    robot = station.robot
+    state = _State(q=robot.home.copy(), robot=robot, opts=opts)
+    steps: list[Step] = []
+    diags: list[Diagnostic] = []
+    for index, ins in enumerate(program.instructions):
+        if not isinstance(ins, MOTION_TYPES):
+            steps.append(Step(index=index, instruction=ins))
+            continue
+        step, found = _resolve_motion(index, ins, station, state)
+        steps.append(step)
+        diags.extend(found)
+    return CompiledProgram(
+        program=program,
+        station=station,
+        start_joints=robot.home.copy(),
+        steps=tuple(steps),
+        diagnostics=tuple(diags),
+    )
+
+
+@dataclass(slots=True)
+class _State:
+    q: FloatArray
+    robot: Robot
+    opts: ResolveOptions
+
+
+def _error(kind: str, message: str, index: int, ins: Instruction, **kw: object) -> Diagnostic:
+    return Diagnostic("error", kind, message, ins.span, index, **kw)  # type: ignore[arg-type]
+
+
+def _resolve_motion(
+    index: int, ins: JointMove | LinearMove | CircularMove, station: Station, state: _State
+) -> tuple[Step, list[Diagnostic]]:
+    tool = ins.tool if ins.tool.pose is not None else station.tool(ins.tool)
+    frame = ins.frame if ins.frame.pose is not None else station.frame(ins.frame)
+    diags: list[Diagnostic] = []
+    if tool is None:
+        diags.append(
+            _error(
+                "unknown_tool", f"tool {ins.tool.name!r} is not defined in the station", index, ins
+            )
+        )
+    if frame is None:
+        diags.append(
+            _error(
+                "unknown_frame",
+                f"frame {ins.frame.name!r} is not defined in the station",
+                index,
+                ins,
+            )
+        )
+    if tool is None or frame is None:
+        return Step(index=index, instruction=ins, tool=tool, frame=frame), diags
+    if isinstance(ins, CircularMove):
+        diags.append(_error("unsupported", "circular moves are not resolved yet", index, ins))
+        return Step(index=index, instruction=ins, tool=tool, frame=frame), diags
+    if isinstance(ins, LinearMove):
+        path, found = _linear_path(index, ins, tool, frame, state)
+    else:
+        path, found = _joint_path(index, ins, tool, frame, state)
+    diags.extend(found)
+    if path is None:
+        _restart_at_target(ins, tool, frame, state)
+        return Step(index=index, instruction=ins, tool=tool, frame=frame), diags
+    state.q = path[-1].copy()
+    return Step(
+        index=index, instruction=ins, joints=path[-1], path=path, tool=tool, frame=frame
+    ), diags
+
+
+def _restart_at_target(
+    ins: JointMove | LinearMove, tool: Tool, frame: Frame, state: _State
+) -> None:
+    """After a failed move, check the next one from the target itself (nearest IK solution) so
+    that one bad move does not make every following move fail too."""
+    if isinstance(ins.target, JointTarget):
+        if ins.target.joints.shape == state.q.shape:
+            state.q = np.clip(ins.target.joints, state.robot.limits.lower, state.robot.limits.upper)
+        return
+    candidates = _candidates(state.robot, flange_target(ins.target, tool, frame))
+    if candidates.shape[0]:
+        state.q = _nearest(candidates, state.q, state.opts.weights)
+
+
+def flange_target(target: CartesianTarget, tool: Tool, frame: Frame) -> FloatArray:
+    """World pose (4, 4) of the flange that puts the tool's TCP on ``target`` in ``frame``."""
+    assert tool.pose is not None and frame.pose is not None
+    return frame.pose @ target.pose @ inv(tool.pose)
+
+
+def _joint_path(
+    index: int, ins: JointMove, tool: Tool, frame: Frame, state: _State
+) -> tuple[FloatArray | None, list[Diagnostic]]:
+    robot = state.robot
+    if isinstance(ins.target, JointTarget):
+        q = ins.target.joints
+        if q.shape != (robot.dof,):
+            msg = f"joint target has {q.size} values, the robot has {robot.dof} axes"
+            return None, [_error("bad_target", msg, index, ins)]
+        bad = robot.limits.violations(q)
+        if np.any(bad):
+            return None, [_limit_error(index, ins, robot, q, bad)]
+        return _joint_line(state.q, q), []
+    flange = flange_target(ins.target, tool, frame)
+    candidates = _candidates(robot, flange)
+    if candidates.shape[0] == 0:
+        return None, [_unreachable(index, ins, robot, flange)]
+    return _joint_line(state.q, _nearest(candidates, state.q, state.opts.weights)), []
+
+
+def _joint_line(q0: FloatArray, q1: FloatArray, step: float = np.radians(2.0)) -> FloatArray:
+    """The joint-space straight line from ``q0`` to ``q1`` sampled every ``step`` rad (or finer)
+    on the axis that moves most: (S, 6). The box of joint limits is convex, so the line stays
+    inside the limits when both ends do; the samples serve path length and later collision
+    checks."""
+    count = int(max(np.ceil(np.max(np.abs(q1 - q0)) / step), 1))
+    fractions = np.linspace(0.0, 1.0, count + 1)[:, None]
+    line: FloatArray = q0 + fractions * (q1 - q0)
+    return line
+
+
+def _nearest(candidates: FloatArray, q: FloatArray, weights: tuple[float, ...]) -> FloatArray:
+    """The candidate (K, 6) nearest to ``q`` in the weighted joint distance."""
+    cost = np.sum(np.asarray(weights) * (candidates - q) ** 2, axis=-1)
+    best: FloatArray = candidates[np.argmin(cost)]
+    return best
+
+
+def _candidates(robot: Robot, flange: FloatArray) -> FloatArray:
+    """Every IK solution within the joint limits, (K, 6), turn variants included."""
+    sols = robot.solve(flange[None])[0]
+    variants = turn_variants(sols, robot.limits.lower, robot.limits.upper).reshape(-1, robot.dof)
+    ok = np.all(np.isfinite(variants), axis=-1) & ~np.any(
+        robot.limits.violations(variants), axis=-1
+    )
+    return variants[ok]
+
+
+def _linear_path(
+    index: int, ins: LinearMove, tool: Tool, frame: Frame, state: _State
+) -> tuple[FloatArray | None, list[Diagnostic]]:
+    robot = state.robot
+    assert tool.pose is not None
+    start = robot.flange_poses(state.q)
+    if isinstance(ins.target, JointTarget):
+        end = robot.flange_poses(ins.target.joints)
+    else:
+        end = flange_target(ins.target, tool, frame)
+    # Sample the TCP line, not the flange line: with a long tool they differ.
+    tcp_start, tcp_end = start @ tool.pose, end @ tool.pose
+    dist, angle = pose_distance(tcp_start, tcp_end)
+    count = max(
+        int(np.ceil(dist / state.opts.step_m)), int(np.ceil(angle / state.opts.step_rad)), 1
+    )
+    fractions = np.linspace(0.0, 1.0, count + 1)
+    flanges = interpolate_poses(tcp_start, tcp_end, fractions) @ inv(tool.pose)
+    branch = robot.branch_of(state.q)
+    sols = robot.solve(flanges)[:, branch, :]
+    if np.any(~np.isfinite(sols)):
+        first = int(np.argmax(~np.all(np.isfinite(sols), axis=-1)))
+        if first == len(fractions) - 1 and isinstance(ins.target, CartesianTarget):
+            return None, [_unreachable(index, ins, robot, end)]
+        msg = (
+            f"the straight line leaves the robot's workspace at {fractions[first]:.0%} of the move"
+            " (in the configuration the move starts in)"
+        )
+        return None, [_error("unreachable_path", msg, index, ins)]
+    path = _unwrap(state.q, sols)
+    bad = robot.limits.violations(path)
+    if np.any(bad):
+        row = int(np.argmax(np.any(bad, axis=-1)))
+        return None, [_limit_error(index, ins, robot, path[row], bad[row], fractions[row])]
+    jumps = np.abs(np.diff(path, axis=0))
+    if np.any(jumps > state.opts.max_joint_step_rad):
+        row = int(np.argmax(np.max(jumps, axis=-1)))
+        joint = int(np.argmax(jumps[row]))
+        msg = (
+            f"axis {joint + 1} would turn {np.degrees(jumps[row, joint]):.1f}° within "
+            f"{dist / count * 1000:.1f} mm at {fractions[row]:.0%} of the linear move: "
+            "it passes through or near a singularity"
+        )
+        hint = "use a joint move, or change the tool orientation to avoid the singular pose"
+        return None, [_error("singularity", msg, index, ins, joints=path[row], hint=hint)]
+    return path, []
+
+
+def _unwrap(q0: FloatArray, sols: FloatArray) -> FloatArray:
+    """Make IK solutions (S, 6) of one branch continuous from ``q0``: each row is the previous
+    one plus the wrapped step, so turns follow from the start joints. Row 0 is (close to) q0."""
+    steps = np.diff(np.vstack([q0[None], sols]), axis=0)
+    steps = (steps + np.pi) % (2 * np.pi) - np.pi
+    out: FloatArray = q0 + np.cumsum(steps, axis=0)
+    return out
+
+
+def _unreachable(index: int, ins: Instruction, robot: Robot, flange: FloatArray) -> Diagnostic:
+    sols = robot.solve(flange[None])[0]
+    finite = sols[np.all(np.isfinite(sols), axis=-1)]
+    if finite.shape[0] == 0:
+        base = inv(robot.base) @ flange
+        reach = np.linalg.norm(base[:3, 3]) * 1000
+        msg = (
+            f"target is out of the robot's reach (flange {reach:.1f} mm from the robot base "
+            "origin; no IK solution in any configuration)"
+        )
+        return _error("unreachable", msg, index, ins)
+    excess = np.maximum(robot.limits.lower - finite, 0) + np.maximum(finite - robot.limits.upper, 0)
+    worst = np.max(excess, axis=-1)
+    best = int(np.argmin(worst))
+    joint = int(np.argmax(excess[best]))
+    msg = (
+        f"target is reachable only outside the joint limits: the nearest solution needs axis "
+        f"{joint + 1} at {np.degrees(finite[best, joint]):.2f}° (limits {_range(robot, joint)})"
+    )
+    return _error("joint_limit", msg, index, ins, joints=finite[best])
+
+
+def _limit_error(
+    index: int,
+    ins: Instruction,
+    robot: Robot,
+    q: FloatArray,
+    bad: NDArray[np.bool_],
+    fraction: float | None = None,
+) -> Diagnostic:
+    joint = int(np.argmax(bad))
+    where = "" if fraction is None else f" at {fraction:.0%} of the move"
+    msg = (
+        f"axis {joint + 1} at {np.degrees(q[joint]):.2f}°{where} is outside its limits "
+        f"{_range(robot, joint)}"
+    )
+    return _error("joint_limit", msg, index, ins, joints=q)
+
+
+def _range(robot: Robot, joint: int) -> str:
+    lower, upper = np.degrees([robot.limits.lower[joint], robot.limits.upper[joint]])
+    return f"{lower:.0f}° .. {upper:.0f}°"
+
+
+def replace_step(step: Step, **changes: object) -> Step:
+    """A copy of ``step`` with fields changed (used by later passes)."""
+    return dataclasses.replace(step, **changes)  # type: ignore[arg-type]

@@ -1,0 +1,154 @@
+"""KUKA KR C4 (KSS 8) conventions: ABC angles, FRAME values, flange frame, Status and Turn.
+
+Used by the KRL frontend and the KUKA post alike; nothing else in olp knows these rules.
+
+Sources
+-------
+* ABC: ``R = Rz(A) · Ry(B) · Rx(C)`` (intrinsic Z, Y', X''), angles in degrees, positions in mm.
+  KUKA System Software 8 operating and programming instructions, "BASE/TOOL coordinate system";
+  also how ROS-Industrial's kuka_rsi driver converts ABC. Pinned by ``tests/vendors/test_kuka.py``.
+* Flange frame: KUKA's FLANGE frame has X pointing out of the mounting flange. The kinematic
+  models in olp use the ROS-Industrial ``tool0`` convention (Z out of the flange). The
+  ROS-Industrial KUKA descriptions (kuka_experimental, e.g. ``kr6r900sixx_macro.xacro``) attach
+  ``tool0`` to ``link_6`` (= KUKA's flange) with ``rpy = (0, 90°, 0)``; hence
+  ``flange = tool0 · Ry(-90°)``, :data:`FLANGE_IN_TOOL0`.
+* Turn (T): bit ``i`` is set when axis ``A(i+1) < 0``; exactly 0 gives 0.
+* Status (S): see :func:`status_bits` (bit 0 overhead, bit 1 A3 position, bit 2 A5 < 0).
+  Status and Turn only matter for PTP motions; LIN/CIRC ignore them on the controller.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from olp.diagnostics import Diagnostic
+from olp.geometry import pose_from, rotation_from_zyx, roty, zyx_from_rotation
+
+FloatArray = NDArray[np.float64]
+
+FLANGE_IN_TOOL0: FloatArray = roty(-math.pi / 2)
+"""KUKA's flange frame (X out of the flange) expressed in the model's tool0 frame (Z out)."""
+
+
+def abc_to_rotation(a: ArrayLike, b: ArrayLike, c: ArrayLike) -> FloatArray:
+    """Rotation matrices (..., 3, 3) from KUKA A, B, C in **radians**: ``Rz(A) Ry(B) Rx(C)``."""
+    return rotation_from_zyx(a, b, c)
+
+
+def rotation_to_abc(rotation: ArrayLike) -> FloatArray:
+    """KUKA (A, B, C) in radians, shape (..., 3), from rotation matrices (..., 3, 3).
+
+    A and C lie in (-pi, pi] (so -180° is written as 180°), B in [-pi/2, pi/2]. At gimbal lock
+    (B = ±90°) A and C are not unique; olp then writes C = 0 and puts the rotation into A.
+    """
+    return zyx_from_rotation(rotation)
+
+
+def frame_to_pose(xyzabc: ArrayLike) -> FloatArray:
+    """Poses (..., 4, 4) in metres from KRL values ``X, Y, Z`` (mm) and ``A, B, C`` (deg)."""
+    v = np.asarray(xyzabc, dtype=np.float64)
+    rot = abc_to_rotation(*np.radians(np.moveaxis(v[..., 3:6], -1, 0)))
+    return pose_from(rot, v[..., :3] / 1000.0)
+
+
+def pose_to_frame(pose: ArrayLike) -> FloatArray:
+    """KRL ``X, Y, Z`` (mm) and ``A, B, C`` (deg), shape (..., 6), from poses (..., 4, 4) in m."""
+    t = np.asarray(pose, dtype=np.float64)
+    abc = np.degrees(rotation_to_abc(t[..., :3, :3]))
+    return np.concatenate([t[..., :3, 3] * 1000.0, abc], axis=-1)
+
+
+def turn_bits(joints: ArrayLike) -> NDArray[np.int64]:
+    """KUKA Turn (T) from controller joint values (..., n) in radians: bit i set if A(i+1) < 0."""
+    q = np.asarray(joints, dtype=np.float64)
+    weights = 1 << np.arange(q.shape[-1], dtype=np.int64)
+    return np.sum((q < 0) * weights, axis=-1)
+
+
+def status_bits(
+    joints: ArrayLike, wrist_x_in_a1: ArrayLike, a3_threshold: float
+) -> NDArray[np.int64]:
+    """KUKA Status (S) from controller joints (..., 6) in radians.
+
+    Bit 0: overhead area, the wrist centre has x < 0 in the frame that rotates with A1
+    (``wrist_x_in_a1``, metres). Bit 1: set when ``A3 >= a3_threshold`` (rad; the angle at which
+    the A3/A4 offset puts the wrist centre on the line of the upper arm; 0 when the axes
+    intersect). Bit 2: set when ``A5 < 0``. Bits 3 and 4 are written as 0.
+
+    Confidence: bits 0 and 2 match the KSS documentation and taught points from a public KR C4
+    backup; the bit 1 threshold is derived from the geometry, not quoted from KUKA (unverified).
+    """
+    q = np.asarray(joints, dtype=np.float64)
+    overhead = np.asarray(wrist_x_in_a1) < 0
+    elbow = q[..., 2] >= a3_threshold
+    flip = q[..., 4] < 0
+    return overhead.astype(np.int64) + 2 * elbow.astype(np.int64) + 4 * flip.astype(np.int64)
+
+
+# --------------------------------------------------------------------------------------------
+# Spelling for the KRL post (templates call these as filters)
+
+POSITION_DECIMALS = 3
+"""mm; KRL positions as the pendant writes them (1 µm)."""
+ANGLE_DECIMALS = 4
+"""deg for A, B, C (at 1 m, 0.0001° is 1.7 µm)."""
+AXIS_DECIMALS = 5
+"""deg for A1..A6, as in programs written by KUKA's own tools."""
+
+MAX_NAME_LENGTH = 24
+"""KRL identifiers and module names: 24 characters (widely cited; unverified against KUKA docs)."""
+
+
+def _num(value: float, decimals: int) -> str:
+    text = f"{float(value):.{decimals}f}"
+    return text[1:] if text.startswith("-") and float(text) == 0.0 else text
+
+
+def krl_frame(pose: ArrayLike) -> str:
+    """``X 1.000,Y 2.000,Z 3.000,A 0.0000,B 90.0000,C 0.0000`` from a pose (4, 4) in metres."""
+    x, y, z, a, b, c = pose_to_frame(pose)
+    values = [_num(v, POSITION_DECIMALS) for v in (x, y, z)]
+    values += [_num(v, ANGLE_DECIMALS) for v in (a, b, c)]
+    return ",".join(f"{k} {v}" for k, v in zip("XYZABC", values, strict=True))
+
+
+def krl_axis(joints: ArrayLike) -> str:
+    """``A1 0.00000,A2 -90.00000,...`` from controller joint values (6,) in radians."""
+    deg = np.degrees(np.asarray(joints, dtype=np.float64))
+    return ",".join(f"A{i + 1} {_num(v, AXIS_DECIMALS)}" for i, v in enumerate(deg))
+
+
+def legal_name(name: str) -> str:
+    """A legal KRL module name: letters, digits and ``_``, starting with a letter, at most 24
+    characters. The .src/.dat file names use it too (KRL requires DEF name == file name)."""
+    cleaned = "".join(ch if (ch.isascii() and (ch.isalnum() or ch == "_")) else "_" for ch in name)
+    if not cleaned or not cleaned[0].isalpha():
+        cleaned = "P" + cleaned
+    return cleaned[:MAX_NAME_LENGTH]
+
+
+TEMPLATE_FILTERS = {"krl_frame": krl_frame, "krl_axis": krl_axis}
+
+
+def post_diagnostics(compiled: Any) -> list[Diagnostic]:
+    """What the KRL post cannot say exactly. Joint moves with a zone are written as exact stops:
+    KRL approximates PTP with ``C_PTP`` and ``$APO.CPTP`` in percent of the axis travel, which a
+    distance zone does not translate to (timing already assumes stops, so estimates still hold)."""
+    out = []
+    for step in compiled.steps:
+        ins = step.instruction
+        if getattr(ins, "kind", None) == "joint" and not ins.zone.is_fine:
+            out.append(
+                Diagnostic(
+                    "warning",
+                    "zone_dropped",
+                    f"PTP with a {ins.zone.radius * 1000:.1f} mm zone is written as an exact stop",
+                    ins.span,
+                    step.index,
+                )
+            )
+    return out
