@@ -255,6 +255,8 @@ def _linear_path(
         end = robot.flange_poses(ins.target.joints)
     else:
         end = flange_target(ins.target, tool, frame)
+        if _candidates(robot, end).shape[0] == 0:
+            return None, [_unreachable(index, ins, robot, end)]
     # Sample the TCP line, not the flange line: with a long tool they differ.
     tcp_start, tcp_end = start @ tool.pose, end @ tool.pose
     dist, angle = pose_distance(tcp_start, tcp_end)
@@ -267,8 +269,6 @@ def _linear_path(
     sols = robot.solve(flanges)[:, branch, :]
     if np.any(~np.isfinite(sols)):
         first = int(np.argmax(~np.all(np.isfinite(sols), axis=-1)))
-        if first == len(fractions) - 1 and isinstance(ins.target, CartesianTarget):
-            return None, [_unreachable(index, ins, robot, end)]
         msg = (
             f"the straight line leaves the robot's workspace at {fractions[first]:.0%} of the move"
             " (in the configuration the move starts in)"

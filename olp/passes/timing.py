@@ -125,7 +125,7 @@ def path_duration(
         return 0.0
     ss = np.linspace(0.0, 1.0, path.shape[0])
     spline = toppra.SplineInterpolator(ss, path)
-    gridpoints = np.linspace(0.0, 1.0, grid or max(2 * path.shape[0], 101))
+    gridpoints = _gridpoints(grid or max(2 * path.shape[0], 101))
     limits: list[object] = [
         constraint.JointVelocityConstraint(robot.limits.velocity),
         constraint.JointAccelerationConstraint(robot.limits.acceleration),
@@ -139,6 +139,19 @@ def path_duration(
     if trajectory is None:
         raise RuntimeError("TOPPRA found no feasible time parameterisation for a path move")
     return float(trajectory.duration)
+
+
+def _gridpoints(count: int) -> FloatArray:
+    """A uniform grid on [0, 1] refined geometrically towards both ends.
+
+    TOPPRA holds the path acceleration constant between gridpoints, so a start or stop ramp takes
+    at least one grid interval: on a uniform grid of a slow 200 mm move that alone added 0.2 s
+    (2%). Intervals shrinking to 1e-7 of the move at the ends make the ramps as short as the
+    limits allow.
+    """
+    uniform = np.linspace(0.0, 1.0, count)
+    ends = np.logspace(-7, np.log10(1.0 / count), 24)
+    return np.unique(np.concatenate([uniform, ends, 1.0 - ends]))
 
 
 class PathSpeedConstraint(constraint.LinearConstraint):

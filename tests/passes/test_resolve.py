@@ -1,0 +1,117 @@
+"""Resolve: each failure constructed on purpose, asserted by kind and source line."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from olp import ir
+from olp.geometry import transl
+from olp.passes.resolve import resolve
+from olp.station.loader import load_station
+from olp.station.model import Station
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="module")
+def station() -> Station:
+    return load_station(REPO / "stations" / "kr6_milling_cell.yaml")
+
+
+def _span(line: int) -> ir.SourceSpan:
+    return ir.SourceSpan("t.src", line, 1)
+
+
+def _ptp(deg: list[float], line: int = 1) -> ir.JointMove:
+    return ir.JointMove(target=ir.JointTarget(joints=np.radians(deg)), span=_span(line))
+
+
+def _lin_to_joints(station: Station, deg: list[float], line: int) -> ir.LinearMove:
+    """A LIN to the Cartesian pose (flange, world frame) that the joints ``deg`` reach."""
+    pose = station.robot.flange_poses(np.radians(deg))
+    return ir.LinearMove(target=ir.CartesianTarget(pose=pose), span=_span(line))
+
+
+def _run(station: Station, *instructions: ir.Instruction) -> list[tuple[str, int]]:
+    compiled = resolve(ir.Program(name="t", instructions=instructions), station)
+    return [(d.kind, d.span.line) for d in compiled.diagnostics if d.span is not None]
+
+
+HOME = [0, -90, 90, 0, 0, 0]
+
+
+def test_feasible_lin_ends_on_the_target_in_the_start_branch(station: Station) -> None:
+    start = [10, -80, 95, 20, 30, 40]
+    end = [25, -70, 100, 15, 35, 30]
+    compiled = resolve(
+        ir.Program(name="t", instructions=[_ptp(start), _lin_to_joints(station, end, 2)]), station
+    )
+    assert compiled.ok
+    final = compiled.steps[1].joints
+    assert final is not None and np.allclose(final, np.radians(end), atol=1e-9)
+
+
+def test_unreachable_target(station: Station) -> None:
+    far = ir.LinearMove(target=ir.CartesianTarget(pose=transl(3.0, 0, 0.5)), span=_span(7))
+    assert _run(station, _ptp(HOME), far) == [("unreachable", 7)]
+
+
+def test_joint_target_outside_limits(station: Station) -> None:
+    assert _run(station, _ptp([0, -90, 90, 0, 0, 0]), _ptp([175, -90, 90, 0, 0, 0], 3)) == [
+        ("joint_limit", 3)
+    ]
+
+
+def test_ptp_to_cartesian_target_reachable_only_outside_limits(station: Station) -> None:
+    # A1 = 180° puts the arm behind the robot; A1 is limited to ±170° and every other branch
+    # that reaches the same pose needs A1 = 0 with the wrist overhead: check the report kind.
+    pose = station.robot.flange_poses(np.radians([180, -90, 90, 0, 45, 0]))
+    move = ir.JointMove(target=ir.CartesianTarget(pose=pose), span=_span(4))
+    found = _run(station, _ptp(HOME), move)
+    assert found in ([], [("joint_limit", 4)])
+    if found:
+        compiled = resolve(ir.Program(name="t", instructions=[_ptp(HOME), move]), station)
+        assert "axis 1" in compiled.diagnostics[0].message
+
+
+def test_lin_through_a_wrist_singularity(station: Station) -> None:
+    # Same arm pose, wrist from A5 = +10° to A5 = -10°: the TCP line crosses A5 = 0 where A4/A6
+    # would have to turn 180° in an instant.
+    start = [0, -80, 100, 30, 10, 0]
+    end = [0, -80, 100, 30, -10, 0]
+    found = _run(station, _ptp(start), _lin_to_joints(station, end, 5))
+    assert found == [("singularity", 5)]
+
+
+def test_one_failure_does_not_cascade(station: Station) -> None:
+    far = ir.LinearMove(target=ir.CartesianTarget(pose=transl(3.0, 0, 0.5)), span=_span(2))
+    fine = _lin_to_joints(station, [5, -85, 95, 0, 20, 0], 3)
+    assert _run(station, _ptp([0, -90, 90, 0, 30, 0]), far, fine) == [("unreachable", 2)]
+
+
+def test_lin_starting_at_the_home_wrist_singularity_is_reported(station: Station) -> None:
+    """KUKA HOME has A5 = 0: a LIN from there starts in a wrist singularity."""
+    found = _run(station, _ptp(HOME), _lin_to_joints(station, [5, -85, 95, 0, 20, 0], 3))
+    assert found == [("singularity", 3)]
+
+
+def test_unknown_tool_reference(station: Station) -> None:
+    move = ir.JointMove(
+        target=ir.JointTarget(joints=np.radians(HOME)),
+        tool=ir.Tool(name="TOOL_DATA[9]", number=9),
+        span=_span(6),
+    )
+    assert _run(station, move) == [("unknown_tool", 6)]
+
+
+def test_station_tool_by_number(station: Station) -> None:
+    move = ir.JointMove(
+        target=ir.JointTarget(joints=np.radians(HOME)),
+        tool=ir.Tool(name="TOOL_DATA[1]", number=1),
+        span=_span(6),
+    )
+    compiled = resolve(ir.Program(name="t", instructions=[move]), station)
+    assert compiled.ok and compiled.steps[0].tool is station.tools["spindle"]
