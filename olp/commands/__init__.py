@@ -1,0 +1,15 @@
+"""``olp`` subcommands, one module each. A module defines::
+
+    NAME = "build"
+    HELP = "one line for ``olp --help``"
+    def add_arguments(parser: argparse.ArgumentParser) -> None: ...
+    def run(args: argparse.Namespace) -> int: ...          # the exit code
+
+and is listed in :data:`COMMANDS`. Modules import heavy packages inside ``run`` only, so that
+``olp --help`` stays fast.
+"""
+
+from __future__ import annotations
+
+COMMANDS: tuple[str, ...] = ("build", "posts", "robots")
+"""Command module names under :mod:`olp.commands`, in ``olp --help`` order."""
