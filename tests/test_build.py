@@ -9,10 +9,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from olp.frontends.krl import load_krl, parse_krl
 
 import olp
 from olp.cli import main
+from olp.frontends.krl import load_krl, parse_krl
 from olp.ir import CartesianTarget, JointTarget
 
 REPO = Path(__file__).resolve().parents[1]
