@@ -159,9 +159,10 @@ def rotation_log(rotation: ArrayLike) -> FloatArray:
     general = (
         np.where(sin > 1e-6, angle[..., None] / np.where(sin > 1e-6, 2 * sin, 1.0), 0.5) * skew
     )
-    near_pi = angle > np.pi - 1e-3
+    near_pi = np.asarray(angle > np.pi - 1e-3)
     if np.any(near_pi):
-        general = np.where(near_pi[..., None], _log_near_pi(r, angle, skew), general)
+        general = np.array(general)
+        general[near_pi] = _log_near_pi(r[near_pi], angle[near_pi], skew[near_pi])
     return general
 
 

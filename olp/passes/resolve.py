@@ -37,6 +37,7 @@ from olp.ir import (
     is_motion,
 )
 from olp.kinematics.opw import turn_variants
+from olp.passes.sampling import sample_segments
 from olp.station.model import Robot, Station
 
 FloatArray = NDArray[np.float64]
@@ -110,13 +111,24 @@ def resolve(
     state = _State(q=robot.home.copy(), robot=robot, opts=opts)
     steps: list[Step] = []
     diags: list[Diagnostic] = []
-    for index, ins in enumerate(program.instructions):
-        if not isinstance(ins, MOTION_TYPES):
-            steps.append(Step(index=index, instruction=ins))
+    instructions = program.instructions
+    index = 0
+    while index < len(instructions):
+        ins = instructions[index]
+        run = _linear_run(instructions, index, station)
+        if run:
+            found_steps, found = _resolve_linear_run(index, run, station, state)
+            steps.extend(found_steps)
+            diags.extend(found)
+            index += len(run)
             continue
-        step, found = _resolve_motion(index, ins, station, state)
-        steps.append(step)
-        diags.extend(found)
+        if isinstance(ins, MOTION_TYPES):
+            step, found = _resolve_motion(index, ins, station, state)
+            steps.append(step)
+            diags.extend(found)
+        else:
+            steps.append(Step(index=index, instruction=ins))
+        index += 1
     return CompiledProgram(
         program=program,
         station=station,
@@ -135,6 +147,99 @@ class _State:
 
 def _error(kind: str, message: str, index: int, ins: Instruction, **kw: object) -> Diagnostic:
     return Diagnostic("error", kind, message, ins.span, index, **kw)  # type: ignore[arg-type]
+
+
+_RUN_CHUNK = 4096
+"""Linear moves resolved per vectorised batch (bounds memory on huge toolpaths)."""
+
+
+def _linear_run(
+    instructions: tuple[Instruction, ...], start: int, station: Station
+) -> list[tuple[LinearMove, Tool, Frame]]:
+    """The consecutive linear moves from ``start`` to Cartesian targets with one resolvable tool
+    and resolvable frames, with their resolved tool and frames (empty if none start here)."""
+    run: list[tuple[LinearMove, Tool, Frame]] = []
+    first_tool: Tool | None = None
+    for ins in instructions[start:]:
+        if not (isinstance(ins, LinearMove) and isinstance(ins.target, CartesianTarget)):
+            break
+        tool = ins.tool if ins.tool.pose is not None else station.tool(ins.tool)
+        frame = ins.frame if ins.frame.pose is not None else station.frame(ins.frame)
+        if tool is None or frame is None or (first_tool is not None and tool != first_tool):
+            break
+        first_tool = tool
+        run.append((ins, tool, frame))
+    return run
+
+
+def _resolve_linear_run(
+    first: int, run: list[tuple[LinearMove, Tool, Frame]], station: Station, state: _State
+) -> tuple[list[Step], list[Diagnostic]]:
+    """Resolve consecutive linear moves in vectorised batches.
+
+    The whole chain is sampled and solved at once in the branch it starts in. At the first
+    sample that fails (no solution, a joint limit, a joint jump), the moves before it are
+    accepted and the failing move is analysed alone by the per-move code, which words the
+    diagnostic exactly as for a single move (the same sampling rules apply); the batch then
+    goes on after it.
+    """
+    steps: list[Step] = []
+    diags: list[Diagnostic] = []
+    k = 0
+    while k < len(run):
+        chunk = run[k : k + _RUN_CHUNK]
+        path, ends, bad = _batch_path(chunk, state)
+        good = len(chunk) if bad is None else bad
+        for m in range(good):
+            lo = 0 if m == 0 else int(ends[m - 1])
+            ins, tool, frame = chunk[m]
+            segment = path[lo : int(ends[m]) + 1]
+            steps.append(
+                Step(
+                    index=first + k + m,
+                    instruction=ins,
+                    joints=segment[-1],
+                    path=segment,
+                    tool=tool,
+                    frame=frame,
+                )
+            )
+        if good:
+            state.q = path[int(ends[good - 1])].copy()
+        if bad is not None:
+            step, found = _resolve_motion(first + k + bad, chunk[bad][0], station, state)
+            steps.append(step)
+            diags.extend(found)
+        k += good + (0 if bad is None else 1)
+    return steps, diags
+
+
+def _batch_path(
+    chunk: list[tuple[LinearMove, Tool, Frame]], state: _State
+) -> tuple[FloatArray, NDArray[np.int64], int | None]:
+    """Joint path (S + 1, 6) of a chain of linear moves from ``state.q`` (row 0), the row of
+    each move's end (M,), and the index of the first move that fails, or None."""
+    robot, opts = state.robot, state.opts
+    tool_pose = chunk[0][1].pose
+    assert tool_pose is not None
+    targets = np.stack([_world(frame) @ ins.target.pose for ins, _, frame in chunk])  # type: ignore[union-attr]
+    start = robot.flange_poses(state.q) @ tool_pose
+    samples = sample_segments(start, targets, opts.step_m, opts.step_rad)
+    sols = robot.solve(samples.poses @ inv(tool_pose))[:, robot.branch_of(state.q), :]
+    path = np.vstack([state.q[None], _unwrap(state.q, sols)])
+    ends = samples.ends + 1
+    with np.errstate(invalid="ignore"):
+        invalid = ~np.all(np.isfinite(path[1:]), axis=-1)
+        invalid |= np.any(robot.limits.violations(path[1:]), axis=-1)
+        invalid |= np.any(np.abs(np.diff(path, axis=0)) > opts.max_joint_step_rad, axis=-1)
+    if not np.any(invalid):
+        return path, ends, None
+    return path, ends, int(samples.segment[int(np.argmax(invalid))])
+
+
+def _world(frame: Frame) -> FloatArray:
+    assert frame.pose is not None
+    return frame.pose
 
 
 def _resolve_motion(

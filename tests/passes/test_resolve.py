@@ -115,3 +115,61 @@ def test_station_tool_by_number(station: Station) -> None:
     )
     compiled = resolve(ir.Program(name="t", instructions=[move]), station)
     assert compiled.ok and compiled.steps[0].tool is station.tools["spindle"]
+
+
+def _helix(station: Station, count: int, z_drop: float = 0.0) -> list[ir.Instruction]:
+    tool, frame = station.tools["spindle"], station.frames["table"]
+    t = np.linspace(0, 1, count)
+    xyz = np.column_stack(
+        [0.1 + 0.15 * np.cos(6 * np.pi * t), 0.15 + 0.15 * np.sin(6 * np.pi * t), 0.02 + z_drop * t]
+    )
+    down = np.diag([-1.0, 1.0, -1.0])
+    poses = np.repeat(np.eye(4)[None], count, axis=0)
+    poses[:, :3, :3], poses[:, :3, 3] = down, xyz
+    first = ir.JointMove(target=ir.CartesianTarget(pose=poses[0]), tool=tool, frame=frame)
+    return [first] + [
+        ir.LinearMove(target=ir.CartesianTarget(pose=p), tool=tool, frame=frame, span=_span(i + 2))
+        for i, p in enumerate(poses[1:])
+    ]
+
+
+def _per_move(monkeypatch: pytest.MonkeyPatch, program: ir.Program, station: Station) -> object:
+    import olp.passes.resolve as module
+
+    monkeypatch.setattr(module, "_linear_run", lambda *_: [])
+    return resolve(program, station)
+
+
+def test_batched_linear_runs_equal_the_per_move_path(
+    station: Station, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    program = ir.Program(name="helix", instructions=_helix(station, 400))
+    batched = resolve(program, station)
+    single = _per_move(monkeypatch, program, station)
+    assert batched.ok and single.ok  # type: ignore[attr-defined]
+    for a, b in zip(batched.steps, single.steps, strict=True):  # type: ignore[attr-defined]
+        assert a.index == b.index and a.joints is not None and b.joints is not None
+        assert np.allclose(a.joints, b.joints, atol=1e-12)
+        assert a.path is not None and b.path is not None and a.path.shape == b.path.shape
+
+
+def test_batched_run_reports_a_failure_midway_like_the_per_move_path(
+    station: Station, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    moves = _helix(station, 60)
+    far = ir.LinearMove(
+        target=ir.CartesianTarget(pose=transl(3.0, 0, 0.5)),
+        tool=station.tools["spindle"],
+        frame=station.frames["table"],
+        span=_span(999),
+    )
+    program = ir.Program(name="gap", instructions=[*moves[:30], far, *moves[30:]])
+    batched = resolve(program, station)
+    single = _per_move(monkeypatch, program, station)
+    assert [(d.kind, d.index) for d in batched.diagnostics] == [("unreachable", 30)]
+    assert [(d.kind, d.index, d.message) for d in batched.diagnostics] == [
+        (d.kind, d.index, d.message)
+        for d in single.diagnostics  # type: ignore[attr-defined]
+    ]
+    resolved = [s.joints for s in batched.steps if s.joints is not None]
+    assert len(resolved) == len(program.instructions) - 1

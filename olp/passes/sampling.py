@@ -1,0 +1,64 @@
+"""Sampling of Cartesian paths: many straight TCP segments interpolated at once.
+
+A chain of linear moves is M segments, each from the previous TCP pose to the next target.
+Each segment gets ``n_k = max(ceil(length / step_m), ceil(angle / step_rad), 1)`` samples at
+fractions ``1/n_k, 2/n_k, ..., 1`` (the segment's start is the previous segment's end), linear in
+position and constant-axis in orientation, all in one vectorised pass.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from olp.geometry import pose_distance, pose_from, rotation_exp, rotation_log
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class SegmentSamples:
+    """Samples of M chained segments.
+
+    ``poses``: (S, 4, 4) sampled poses; ``segment``: (S,) segment index of each sample;
+    ``ends``: (M,) index of each segment's last sample (its target); ``fractions``: (S,)
+    position of each sample within its segment, in (0, 1]; ``lengths`` (M,) metres and
+    ``angles`` (M,) radians of the segments.
+    """
+
+    poses: FloatArray
+    segment: IntArray
+    ends: IntArray
+    fractions: FloatArray
+    lengths: FloatArray
+    angles: FloatArray
+
+
+def sample_segments(
+    start: FloatArray, targets: FloatArray, step_m: float, step_rad: float
+) -> SegmentSamples:
+    """Sample the straight segments ``start -> targets[0] -> targets[1] -> ...``.
+
+    Parameters
+    ----------
+    start : (4, 4) pose where the chain starts.
+    targets : (M, 4, 4) segment end poses.
+    step_m, step_rad : largest travel (m) and rotation (rad) between samples.
+    """
+    previous = np.concatenate([start[None], targets[:-1]], axis=0)
+    lengths, angles = pose_distance(previous, targets)
+    counts = np.maximum(
+        np.maximum(np.ceil(lengths / step_m), np.ceil(angles / step_rad)), 1
+    ).astype(np.int64)
+    segment = np.repeat(np.arange(targets.shape[0], dtype=np.int64), counts)
+    ends = np.cumsum(counts) - 1
+    within = np.arange(segment.size, dtype=np.int64) - np.repeat(ends - counts + 1, counts) + 1
+    fractions = within / np.repeat(counts, counts)
+    prev_r, prev_p = previous[:, :3, :3], previous[:, :3, 3]
+    delta = rotation_log(np.swapaxes(prev_r, -1, -2) @ targets[:, :3, :3])
+    rot = prev_r[segment] @ rotation_exp(fractions[:, None] * delta[segment])
+    pos = prev_p[segment] + fractions[:, None] * (targets[:, :3, 3] - prev_p)[segment]
+    return SegmentSamples(pose_from(rot, pos), segment, ends, fractions, lengths, angles)
