@@ -159,6 +159,8 @@ def build_steps(compiled: CompiledProgram) -> list[PostStep]:
         if not isinstance(ins, MOTION_TYPES):
             out.append(PostStep(step.index, ins.kind, source, ins))
             continue
+        if step.skipped:
+            continue
         assert step.joints is not None and step.tool is not None and step.frame is not None
         pose = _pose_in_frame(step, robot.flange_poses(step.joints))
         flags = {

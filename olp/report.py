@@ -39,6 +39,7 @@ def report_dict(result: BuildResult) -> dict[str, Any]:
                 else None
             )
             item["path_length_m"] = round(step.path_length, 9)
+            item["skipped"] = step.skipped
         instructions.append(item)
     return {
         "schema": SCHEMA_VERSION,

@@ -37,7 +37,7 @@ from olp.ir import (
     is_motion,
 )
 from olp.kinematics.opw import turn_variants
-from olp.passes.sampling import sample_segments
+from olp.passes.sampling import SegmentSamples, sample_segments
 from olp.station.model import Robot, Station
 
 FloatArray = NDArray[np.float64]
@@ -51,12 +51,17 @@ class ResolveOptions:
     ``max_joint_step_rad``: a larger joint change between two samples is reported as a
     discontinuity (singularity or configuration flip). ``weights``: per-joint weights of the
     distance used to choose the nearest IK solution.
+    ``fallback_joint``: a linear move that cannot run becomes a joint move to the same target
+    when that one can (USERS.md jobs 2 and 6), with a warning. ``skip_unreachable``: a target
+    that no move can reach is dropped with a warning instead of an error (job 4).
     """
 
     step_m: float = 0.005
     step_rad: float = np.radians(2.0)
     max_joint_step_rad: float = np.radians(15.0)
     weights: tuple[float, ...] = (1.0, 1.0, 1.0, 1.0, 1.0, 1.0)
+    fallback_joint: bool = False
+    skip_unreachable: bool = False
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -76,6 +81,7 @@ class Step:
     frame: Frame | None = None
     duration: float = 0.0
     path_length: float = 0.0
+    skipped: bool = False
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -188,8 +194,10 @@ def _resolve_linear_run(
     k = 0
     while k < len(run):
         chunk = run[k : k + _RUN_CHUNK]
-        path, ends, bad = _batch_path(chunk, state)
+        path, ends, bad, samples = _batch_path(chunk, state)
         good = len(chunk) if bad is None else bad
+        if good:
+            diags.extend(_speed_warnings(first + k, chunk[:good], path, samples, state.robot))
         for m in range(good):
             lo = 0 if m == 0 else int(ends[m - 1])
             ins, tool, frame = chunk[m]
@@ -216,9 +224,9 @@ def _resolve_linear_run(
 
 def _batch_path(
     chunk: list[tuple[LinearMove, Tool, Frame]], state: _State
-) -> tuple[FloatArray, NDArray[np.int64], int | None]:
+) -> tuple[FloatArray, NDArray[np.int64], int | None, SegmentSamples]:
     """Joint path (S + 1, 6) of a chain of linear moves from ``state.q`` (row 0), the row of
-    each move's end (M,), and the index of the first move that fails, or None."""
+    each move's end (M,), the index of the first move that fails (or None), and the samples."""
     robot, opts = state.robot, state.opts
     tool_pose = chunk[0][1].pose
     assert tool_pose is not None
@@ -233,8 +241,67 @@ def _batch_path(
         invalid |= np.any(robot.limits.violations(path[1:]), axis=-1)
         invalid |= np.any(np.abs(np.diff(path, axis=0)) > opts.max_joint_step_rad, axis=-1)
     if not np.any(invalid):
-        return path, ends, None
-    return path, ends, int(samples.segment[int(np.argmax(invalid))])
+        return path, ends, None, samples
+    return path, ends, int(samples.segment[int(np.argmax(invalid))]), samples
+
+
+def _speed_warnings(
+    first: int,
+    moves: list[tuple[LinearMove, Tool, Frame]],
+    path: FloatArray,
+    samples: SegmentSamples,
+    robot: Robot,
+) -> list[Diagnostic]:
+    """Warn where the programmed TCP speed needs a joint faster than its limit.
+
+    Between two samples of a move the TCP travels ``length / count``; at speed ``v`` that takes
+    ``length / (count v)`` seconds, so the joint speed needed is ``|dq| count v / length``. Near a
+    singularity this grows without bound, which makes it a measure of singularity proximity
+    too. The controller slows the TCP down there (the timing pass does the same); consecutive
+    moves that need it are reported together.
+    """
+    m = len(moves)
+    rows = int(samples.ends[m - 1]) + 1
+    segment = samples.segment[:rows]
+    counts = np.diff(np.concatenate([[-1], samples.ends[:m]]))
+    speeds = np.array([ins.speed.linear for ins, _, _ in moves])
+    spacing = samples.lengths[:m] / counts
+    dq = np.abs(np.diff(path[: rows + 1], axis=0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        needed = dq * (speeds / spacing)[segment][:, None]
+    needed[~np.isfinite(needed)] = 0.0
+    ratio = needed / robot.limits.velocity
+    worst_per_move = np.maximum.reduceat(np.max(ratio, axis=1), samples.ends[:m] - counts + 1)
+    over = worst_per_move > 1.0 + 1e-9
+    out: list[Diagnostic] = []
+    for lo, hi in _true_runs(over):
+        rows_in = (segment >= lo) & (segment < hi)
+        row = int(np.argmax(np.where(rows_in[:, None], ratio, 0.0)) // ratio.shape[1])
+        joint = int(np.argmax(ratio[row]))
+        ins = moves[lo][0]
+        where = f"move {first + lo}" if hi - lo == 1 else f"moves {first + lo}-{first + hi - 1}"
+        out.append(
+            Diagnostic(
+                "warning",
+                "speed_limited",
+                f"{where}: {ins.speed.linear * 1000:.0f} mm/s needs axis {joint + 1} at "
+                f"{np.degrees(needed[row, joint]):.0f}°/s (limit "
+                f"{np.degrees(robot.limits.velocity[joint]):.0f}°/s); the TCP will be slower there",
+                ins.span,
+                first + lo,
+                joints=path[row + 1],
+                hint="lower the speed, or keep the path away from singular poses",
+            )
+        )
+    return out
+
+
+def _true_runs(mask: NDArray[np.bool_]) -> list[tuple[int, int]]:
+    """Half-open index ranges [lo, hi) of consecutive True values."""
+    edges = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
+    return list(
+        zip(np.flatnonzero(edges == 1).tolist(), np.flatnonzero(edges == -1).tolist(), strict=True)
+    )
 
 
 def _world(frame: Frame) -> FloatArray:
@@ -272,14 +339,61 @@ def _resolve_motion(
         path, found = _linear_path(index, ins, tool, frame, state)
     else:
         path, found = _joint_path(index, ins, tool, frame, state)
-    diags.extend(found)
     if path is None:
-        _restart_at_target(ins, tool, frame, state)
-        return Step(index=index, instruction=ins, tool=tool, frame=frame), diags
+        return _recover(index, ins, tool, frame, state, diags + found)
+    diags.extend(found)
     state.q = path[-1].copy()
     return Step(
         index=index, instruction=ins, joints=path[-1], path=path, tool=tool, frame=frame
     ), diags
+
+
+_UNREACHABLE = frozenset({"unreachable", "joint_limit"})
+
+
+def _recover(
+    index: int,
+    ins: JointMove | LinearMove,
+    tool: Tool,
+    frame: Frame,
+    state: _State,
+    diags: list[Diagnostic],
+) -> tuple[Step, list[Diagnostic]]:
+    """What happens after a move failed: the joint-move fallback, skipping, or the error."""
+    opts = state.opts
+    if opts.fallback_joint and isinstance(ins, LinearMove):
+        joint = JointMove(
+            target=ins.target,
+            speed=ins.speed,
+            zone=ins.zone,
+            tool=ins.tool,
+            frame=ins.frame,
+            span=ins.span,
+        )
+        path, _found = _joint_path(index, joint, tool, frame, state)
+        if path is not None:
+            why = "; ".join(d.message for d in diags if d.severity == "error")
+            note = Diagnostic(
+                "warning",
+                "fallback_joint",
+                f"linear move written as a joint move: {why}",
+                ins.span,
+                index,
+            )
+            state.q = path[-1].copy()
+            step = Step(
+                index=index, instruction=joint, joints=path[-1], path=path, tool=tool, frame=frame
+            )
+            return step, [*[d for d in diags if d.severity != "error"], note]
+    errors = [d for d in diags if d.severity == "error"]
+    if opts.skip_unreachable and errors and all(d.kind in _UNREACHABLE for d in errors):
+        skipped = [
+            dataclasses.replace(d, severity="warning", message=f"skipped: {d.message}")
+            for d in errors
+        ]
+        return Step(index=index, instruction=ins, tool=tool, frame=frame, skipped=True), skipped
+    _restart_at_target(ins, tool, frame, state)
+    return Step(index=index, instruction=ins, tool=tool, frame=frame), diags
 
 
 def _restart_at_target(

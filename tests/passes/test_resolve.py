@@ -173,3 +173,69 @@ def test_batched_run_reports_a_failure_midway_like_the_per_move_path(
     ]
     resolved = [s.joints for s in batched.steps if s.joints is not None]
     assert len(resolved) == len(program.instructions) - 1
+
+
+def test_fallback_turns_an_impossible_lin_into_a_joint_move(station: Station) -> None:
+    from olp.passes.resolve import ResolveOptions
+
+    start = [0, -80, 100, 30, 10, 0]
+    lin = _lin_to_joints(station, [0, -80, 100, 30, -10, 0], 5)  # crosses A5 = 0
+    program = ir.Program(name="t", instructions=[_ptp(start), lin])
+    plain = resolve(program, station)
+    assert [d.kind for d in plain.diagnostics] == ["singularity"]
+    compiled = resolve(program, station, ResolveOptions(fallback_joint=True))
+    assert compiled.ok
+    step = compiled.steps[1]
+    assert isinstance(step.instruction, ir.JointMove) and step.instruction.span.line == 5
+    assert [(d.severity, d.kind) for d in compiled.diagnostics] == [("warning", "fallback_joint")]
+    assert step.joints is not None
+    reached = station.robot.flange_poses(step.joints)
+    assert np.allclose(reached, lin.target.pose, atol=1e-9)  # type: ignore[union-attr]
+
+
+def test_fallback_does_not_hide_an_unreachable_target(station: Station) -> None:
+    from olp.passes.resolve import ResolveOptions
+
+    far = ir.LinearMove(target=ir.CartesianTarget(pose=transl(3.0, 0, 0.5)), span=_span(2))
+    program = ir.Program(name="t", instructions=[_ptp([0, -90, 90, 0, 30, 0]), far])
+    compiled = resolve(program, station, ResolveOptions(fallback_joint=True))
+    assert [(d.severity, d.kind) for d in compiled.diagnostics] == [("error", "unreachable")]
+
+
+def test_skip_unreachable_drops_the_target_with_a_warning(station: Station) -> None:
+    from olp.passes.resolve import ResolveOptions
+
+    far = ir.LinearMove(target=ir.CartesianTarget(pose=transl(3.0, 0, 0.5)), span=_span(2))
+    fine = _lin_to_joints(station, [5, -85, 95, 0, 20, 0], 3)
+    program = ir.Program(name="t", instructions=[_ptp([0, -90, 90, 0, 30, 0]), far, fine])
+    compiled = resolve(program, station, ResolveOptions(skip_unreachable=True))
+    assert compiled.ok
+    assert [(d.severity, d.kind, d.index) for d in compiled.diagnostics] == [
+        ("warning", "unreachable", 1)
+    ]
+    assert compiled.steps[1].skipped and compiled.steps[1].joints is None
+    assert compiled.steps[2].joints is not None
+
+
+def test_speed_warning_names_the_axis_that_cannot_keep_up(station: Station) -> None:
+    import dataclasses
+
+    from olp.station.model import JointLimits
+
+    robot = station.robot
+    slow_limits = JointLimits(
+        lower=robot.limits.lower,
+        upper=robot.limits.upper,
+        velocity=robot.limits.velocity / 100,
+        acceleration=robot.limits.acceleration,
+        jerk=robot.limits.jerk,
+    )
+    slow = dataclasses.replace(station, robot=dataclasses.replace(robot, limits=slow_limits))
+    moves = _helix(station, 40)
+    fast = [dataclasses.replace(m, speed=ir.Speed(linear=1.0)) for m in moves]
+    program = ir.Program(name="fast", instructions=fast)
+    assert not [d for d in resolve(program, station).diagnostics if d.kind == "speed_limited"]
+    found = [d for d in resolve(program, slow).diagnostics if d.kind == "speed_limited"]
+    assert len(found) == 1  # consecutive moves are reported together
+    assert found[0].severity == "warning" and "moves 1-39" in found[0].message
+    assert "the TCP will be slower" in found[0].message
