@@ -1,0 +1,85 @@
+"""``olp check STATION PROGRAM``: every check, no robot code written.
+
+Exit codes as for ``olp build``: 0 no errors, 1 the program has errors, 2 bad input.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from olp.commands.common import EXIT_OK, EXIT_PROGRAM_ERRORS, print_diagnostics, require_files
+
+if TYPE_CHECKING:
+    from olp.api import BuildResult
+    from olp.passes.resolve import ResolveOptions
+
+NAME = "check"
+HELP = "check a program on a station (reach, limits, singularities) without writing code"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("station", help="station YAML file")
+    parser.add_argument("program", help="program file")
+    add_check_options(parser)
+    parser.add_argument("--report", help="write a JSON report to this file")
+    parser.add_argument("--sarif", help="write the diagnostics as SARIF 2.1.0 to this file")
+    parser.add_argument("-q", "--quiet", action="store_true", help="print errors only")
+
+
+def add_check_options(parser: argparse.ArgumentParser) -> None:
+    """Options that change what the checks accept (shared with ``olp build``)."""
+    parser.add_argument(
+        "--fallback",
+        choices=["none", "joint"],
+        default="none",
+        help="'joint': a linear move that cannot run becomes a joint move when that can",
+    )
+    parser.add_argument(
+        "--skip-unreachable",
+        action="store_true",
+        help="drop targets no move can reach (a warning each) instead of failing",
+    )
+
+
+def resolve_options(args: argparse.Namespace) -> ResolveOptions:
+    """The :class:`~olp.passes.resolve.ResolveOptions` the check options ask for."""
+    from olp.passes.resolve import ResolveOptions
+
+    return ResolveOptions(
+        fallback_joint=args.fallback == "joint", skip_unreachable=args.skip_unreachable
+    )
+
+
+def run(args: argparse.Namespace) -> int:
+    from olp.api import BuildResult, compile, load_station, parse
+    from olp.report import summary
+
+    require_files(args.station, args.program)
+    station = load_station(args.station)
+    parsed = parse(args.program)
+    compiled = compile(parsed.program, station, resolve_options(args))
+    result = BuildResult(compiled, "-", parsed.notes + compiled.diagnostics)
+    print_diagnostics(result.diagnostics, args.program, quiet=args.quiet)
+    write_outputs(args, result)
+    if not args.quiet:
+        print(summary(result))
+    return EXIT_OK if result.ok else EXIT_PROGRAM_ERRORS
+
+
+def write_outputs(args: argparse.Namespace, result: BuildResult) -> None:
+    """Write the ``--report`` JSON and the ``--sarif`` log, each atomically, if asked."""
+    from importlib.metadata import version
+
+    from olp.post import write_files
+    from olp.report import report_json
+    from olp.sarif import sarif_json
+
+    outputs = {}
+    if getattr(args, "report", None):
+        outputs[Path(args.report)] = report_json(result)
+    if getattr(args, "sarif", None):
+        outputs[Path(args.sarif)] = sarif_json(result.diagnostics, version("olp"))
+    for path, text in outputs.items():
+        write_files({path.name: text}, path.parent, "utf-8")
