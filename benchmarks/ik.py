@@ -1,4 +1,4 @@
-"""Batch OPW inverse kinematics against numeric and compiled references.
+"""Batch OPW and UR inverse kinematics against numeric and compiled references.
 
 Run from the repository root: ``python -m benchmarks.ik [--poses N] [--dls-poses M]``.
 
@@ -14,7 +14,13 @@ Run from the repository root: ``python -m benchmarks.ik [--poses N] [--dls-poses
   branch is outside given limits, so it is timed twice: as is, and with limits no branch meets
   (IK, limit margins and reach extension only). Its solutions are compared with olp's.
 
-Everything runs on one core (numpy elementwise code does not use threads).
+* olp's numpy UR IK (all 8 branches) for N tool0 poses of random UR5e joints within the
+  limits, against ur-analytic-ik (C++, one pose per Python call, all branches; when installed)
+  on the first 20,000 poses and the same pinocchio DLS loop on the UR5e DH chain; the solutions
+  are compared with ur-analytic-ik's.
+
+Everything runs on one core (numpy elementwise code does not use threads). The last lines give
+each reference's rate as a ratio to olp's rate for the same arm, measured in the same run.
 """
 
 from __future__ import annotations
@@ -30,8 +36,8 @@ import numpy as np
 import pinocchio as pin
 
 from olp.geometry import pose_distance, wrap_half_open
-from olp.kinematics import opw
-from olp.kinematics.pinocchio_model import TOOL0, build_model
+from olp.kinematics import opw, ur
+from olp.kinematics.pinocchio_model import TOOL0, build_dh_model, build_model
 
 DEG = math.pi / 180.0
 KR6_R900 = opw.OPWParameters(
@@ -41,6 +47,9 @@ KR6_R900 = opw.OPWParameters(
 LOWER = np.array([-170, -190, -120, -185, -120, -350]) * DEG
 UPPER = np.array([170, 45, 156, 185, 120, 350]) * DEG
 HOME = np.array([0, -90, 90, 0, 0, 0]) * DEG
+UR5E = ur.URParameters(0.1625, -0.425, -0.3922, 0.1333, 0.0997, 0.0996)
+UR_LOWER = np.array([-360, -360, -180, -360, -360, -360]) * DEG
+UR_HOME = np.array([0, -90, 90, -90, -90, 0]) * DEG
 
 
 def _timed(fn: Callable[[], Any], repeats: int) -> list[float]:
@@ -104,16 +113,16 @@ def _dls(
     return q, False
 
 
-def bench_dls(poses: np.ndarray) -> float:
-    model = build_model(KR6_R900)
+def bench_dls(poses: np.ndarray, model: pin.Model | None = None, seed: np.ndarray = HOME) -> float:
+    model = build_model(KR6_R900) if model is None else model
     data = model.createData()
     frame = model.getFrameId(TOOL0)
     targets = [pin.SE3(p) for p in poses]
     start = time.perf_counter()
-    results = [_dls(model, data, frame, t, HOME) for t in targets]
+    results = [_dls(model, data, frame, t, seed) for t in targets]
     seconds = time.perf_counter() - start
     converged = sum(ok for _, ok in results)
-    print(f"pinocchio DLS IK (1 branch per pose), {len(poses)} poses from HOME")
+    print(f"pinocchio DLS IK (1 branch per pose), {len(poses)} poses from {model.name} home")
     print(f"  {seconds:.3f} s  {_rate(len(poses), seconds)}, converged {converged}/{len(poses)}")
     return len(poses) / seconds
 
@@ -154,6 +163,53 @@ def bench_rs_opw(poses: np.ndarray) -> dict[str, float]:
     return {"rs_opw_reach": len(poses) / full, "rs_opw_reach_ik_only": len(poses) / ik_only}
 
 
+def bench_ur(poses: np.ndarray, q: np.ndarray, dls_poses: int) -> dict[str, float]:
+    n = len(poses)
+    solutions = ur.inverse(UR5E, poses)
+    warm = _timed(lambda: ur.inverse(UR5E, poses), 5)
+    err = np.max(np.abs(wrap_half_open(solutions - q[:, None, :])), axis=-1)
+    found = np.min(np.where(np.isnan(err), np.inf, err), axis=1)
+    print(f"olp UR IK, numpy, {n:,} UR5e poses x 8 branches")
+    print(f"  warm, allocating output  median {statistics.median(warm):.3f} s")
+    print(f"  input joints recovered: {np.mean(found < 1e-7):.4%} (worst {found.max():.1e} rad)")
+    figures = {"ur_ik_batch": n / statistics.median(warm)}
+    dh = build_dh_model(UR5E.a, ur.ALPHA, UR5E.d)
+    dh.name = "UR5e"
+    figures["ur_pinocchio_dls_ik"] = bench_dls(poses[:dls_poses], dh, UR_HOME)
+    try:
+        from ur_analytic_ik import ur5e
+    except ImportError as exc:
+        print(f"ur-analytic-ik not available ({exc}); `pip install ur-analytic-ik` adds it")
+        return figures
+    sample = [np.ascontiguousarray(p) for p in poses[:20_000]]
+    start = time.perf_counter()
+    theirs = [ur5e.inverse_kinematics(p) for p in sample]
+    seconds = time.perf_counter() - start
+    counts = np.array([len(t) for t in theirs])
+    ours = np.sum(~np.isnan(solutions[: len(sample), :, 0]), axis=1)
+    print(f"ur-analytic-ik inverse_kinematics, C++, 1 pose per call, {len(sample):,} poses")
+    print(
+        f"  {seconds:.3f} s  {_rate(len(sample), seconds)}; same solution count as olp: "
+        f"{np.mean(counts == ours):.2%}"
+    )
+    figures["ur_analytic_ik"] = len(sample) / seconds
+    return figures
+
+
+def _ratios(figures: dict[str, float]) -> None:
+    print()
+    print("ratios (reference rate / olp rate, same run; below 1 means olp is faster):")
+    pairs = [
+        ("pinocchio_dls_ik", "opw_ik_batch"),
+        ("rs_opw_reach_ik_only", "opw_ik_batch"),
+        ("ur_pinocchio_dls_ik", "ur_ik_batch"),
+        ("ur_analytic_ik", "ur_ik_batch"),
+    ]
+    for ref, ours in pairs:
+        if ref in figures and ours in figures:
+            print(f"  {ref} / {ours}: {figures[ref] / figures[ours]:.3g}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--poses", type=int, default=1_000_000)
@@ -166,9 +222,12 @@ def main() -> None:
     figures = bench_opw(poses, q)
     figures["pinocchio_dls_ik"] = bench_dls(poses[: args.dls_poses])
     figures.update(bench_rs_opw(poses[:200_000]))
+    q_ur = rng.uniform(UR_LOWER, -UR_LOWER, (args.poses, 6))
+    figures.update(bench_ur(ur.forward(UR5E, q_ur), q_ur, args.dls_poses))
     print()
     for name, value in figures.items():
         print(f"{name}: {value:.3g} poses/s")
+    _ratios(figures)
 
 
 if __name__ == "__main__":

@@ -46,13 +46,14 @@ the wrist bit follows the controller's sign of axis 5.
 
 from __future__ import annotations
 
-import itertools
 import math
 from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+from olp.kinematics import base as _base
 
 FloatArray = NDArray[np.float64]
 
@@ -458,48 +459,6 @@ def _solve_wrist(
 
 
 # --------------------------------------------------------------------------------------------
-# Turns
+# Turns: shared by every kinematics type, kept importable from here.
 
-
-def _turn_shifts(lower: float, upper: float) -> list[float]:
-    """Multiples of 2 pi that move some value in (-pi, pi] into [lower, upper], 0 first."""
-    lo = math.ceil((lower - math.pi) / _TWO_PI)
-    hi = math.floor((upper + math.pi) / _TWO_PI)
-    turns = sorted(range(lo, hi + 1), key=lambda m: (abs(m), m))
-    return [m * _TWO_PI for m in turns]
-
-
-def turn_variants(
-    q: ArrayLike, lower: ArrayLike, upper: ArrayLike, *, tol: float = 1e-9
-) -> FloatArray:
-    """Every ``q + 2 pi m`` variant of joint solutions that lies inside the joint limits.
-
-    Parameters
-    ----------
-    q : shape (..., 6), controller joints in rad (any turn; they are wrapped first).
-    lower, upper : shape (6,), joint limits in rad (inclusive, widened by ``tol``).
-
-    Returns
-    -------
-    Variants (..., K, 6) in rad, NaN rows for combinations outside the limits (and for NaN input).
-    ``K`` depends only on the limits: the product over joints of the number of turns ``m`` for
-    which ``(-pi, pi] + 2 pi m`` meets ``[lower, upper]`` (1 for a ±170° joint, 2 for KUKA A2
-    -190..45°, 3 for KUKA A6 ±350° or ABB axis 6 ±400°). Variant 0 is the wrapped ``q`` itself
-    (NaN if that is outside the limits); the others follow with turns ordered 0, -1, +1, -2, ...
-    per joint, the last joint varying fastest.
-    """
-    lo = np.asarray(lower, dtype=np.float64)
-    hi = np.asarray(upper, dtype=np.float64)
-    if lo.shape != (6,) or hi.shape != (6,):
-        raise ValueError(f"turn_variants: limits must have shape (6,), got {lo.shape}, {hi.shape}")
-    base = _wrap(np.array(q, dtype=np.float64))
-    if base.shape[-1:] != (6,):
-        raise ValueError(f"turn_variants: expected joints of shape (..., 6), got {base.shape}")
-    shifts = np.array(
-        list(itertools.product(*(_turn_shifts(a, b) for a, b in zip(lo, hi, strict=True))))
-    ).reshape(-1, 6)
-    variants = base[..., None, :] + shifts
-    with np.errstate(invalid="ignore"):
-        inside = np.all((variants >= lo - tol) & (variants <= hi + tol), axis=-1)
-    variants[~inside] = np.nan
-    return variants
+turn_variants = _base.turn_variants

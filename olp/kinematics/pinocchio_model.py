@@ -1,4 +1,6 @@
-"""The OPW arm as a pinocchio chain of six revolute joints.
+"""Robot arms as pinocchio models: the OPW chain, standard-DH chains and URDF chains.
+
+The OPW arm as a pinocchio chain of six revolute joints.
 
 An independent forward-kinematics path: a joint-by-joint chain instead of the closed form of
 :func:`olp.kinematics.opw.forward`, used to cross-check it and to place collision links. The
@@ -99,3 +101,112 @@ def link_poses(model: pin.Model, q: ArrayLike) -> list[FloatArray]:
     pin.framesForwardKinematics(model, data, _configuration(model, q))
     joints = [np.array(data.oMi[i].homogeneous) for i in range(1, model.njoints)]
     return [*joints, np.array(data.oMf[model.getFrameId(TOOL0)].homogeneous)]
+
+
+# --------------------------------------------------------------------------------------------
+# Chains from a DH table and from URDF files
+
+
+def build_dh_model(
+    a: ArrayLike, alpha: ArrayLike, d: ArrayLike, theta_offset: ArrayLike | None = None
+) -> pin.Model:
+    """A revolute chain from a standard (distal) DH table, metres and rad.
+
+    Row ``i``: ``A_i = Rz(q_i + theta_offset_i) · Tz(d_i) · Tx(a_i) · Rx(alpha_i)``; the
+    configuration is ``q`` (n,) in rad. Joint ``joint_i`` turns about Z of frame ``i - 1``; its
+    body frame ``link_i`` is frame ``i - 1`` turned by the joint (shapes attached to link ``i``
+    are given there: the link runs from the origin to ``(a_i, 0, d_i)`` rotated by
+    ``theta_offset_i``). ``tool0`` is DH frame ``n``.
+    """
+    rows = [np.asarray(v, dtype=np.float64) for v in (a, alpha, d)]
+    n = rows[0].shape[0]
+    offsets = np.zeros(n) if theta_offset is None else np.asarray(theta_offset, np.float64)
+    if any(r.shape != (n,) for r in (*rows, offsets)):
+        raise ValueError("build_dh_model: a, alpha, d and theta_offset need the same length")
+    model = pin.Model()
+    model.name = "dh_chain"
+    parent, frame = 0, 0
+    fixed = pin.SE3.Identity()
+    for i in range(n):
+        placement = fixed * pin.SE3(_axis_rotation(_UNIT["z"], float(offsets[i])), np.zeros(3))
+        parent = model.addJoint(parent, pin.JointModelRZ(), placement, f"joint_{i + 1}")
+        frame = model.addJointFrame(parent, frame)
+        frame = model.addBodyFrame(f"link_{i + 1}", parent, pin.SE3.Identity(), frame)
+        fixed = pin.SE3(
+            _axis_rotation(np.array([1.0, 0.0, 0.0]), float(rows[1][i])),
+            np.array([rows[0][i], 0.0, rows[2][i]]),
+        )
+    model.addFrame(pin.Frame(TOOL0, parent, frame, fixed, pin.FrameType.OP_FRAME))
+    return model
+
+
+class ChainError(ValueError):
+    """A URDF chain that cannot serve as a robot (unknown link, no moving joint)."""
+
+
+def load_urdf_model(path: str, tip: str, base: str | None = None) -> pin.Model:
+    """The revolute/prismatic chain of a URDF file from its root (or ``base``) to link ``tip``.
+
+    Joints not on that chain are locked at 0; a frame ``tool0`` is added at ``tip``, and the
+    chain is expressed in ``base`` when given. Raises :class:`ChainError` naming a missing link
+    or a chain without moving joints; pinocchio's own exception on an unreadable file.
+    """
+    full = pin.buildModelFromUrdf(path)
+    if not full.existFrame(tip):
+        raise ChainError(f"link {tip!r} is not in the URDF ({_link_names(full)})")
+    tip_frame = full.frames[full.getFrameId(tip)]
+    chain = set(_support(full, tip_frame.parentJoint))
+    locked = [j for j in range(1, full.njoints) if j not in chain]
+    model = pin.buildReducedModel(full, locked, pin.neutral(full)) if locked else full
+    if model.nq == 0:
+        raise ChainError(f"no moving joint between the URDF's root and link {tip!r}")
+    tip_id = model.getFrameId(tip)
+    tip_frame = model.frames[tip_id]
+    model.addFrame(
+        pin.Frame(TOOL0, tip_frame.parentJoint, tip_id, tip_frame.placement, pin.FrameType.OP_FRAME)
+    )
+    if base is not None:
+        if not model.existFrame(base):
+            raise ChainError(f"link {base!r} is not in the URDF ({_link_names(model)})")
+        _rebase(model, base)
+    return model
+
+
+def _support(model: pin.Model, joint: int) -> list[int]:
+    """Joints from the root to ``joint`` (inclusive), universe excluded."""
+    out = []
+    while joint > 0:
+        out.append(joint)
+        joint = model.parents[joint]
+    return out
+
+
+def _link_names(model: pin.Model) -> str:
+    names = [f.name for f in model.frames if f.type == pin.FrameType.BODY]
+    return "links: " + ", ".join(names)
+
+
+def _rebase(model: pin.Model, base: str) -> None:
+    """Express the model in frame ``base``, which must be fixed to the universe."""
+    frame = model.frames[model.getFrameId(base)]
+    if frame.parentJoint != 0:
+        raise ChainError(f"base link {base!r} moves with a joint; give a fixed link")
+    shift = frame.placement.inverse()
+    for j in range(1, model.njoints):
+        if model.parents[j] == 0:
+            model.jointPlacements[j] = shift * model.jointPlacements[j]
+    for f in model.frames:
+        if f.parentJoint == 0:
+            f.placement = shift * f.placement
+
+
+def frame_poses(model: pin.Model, q: ArrayLike, frame: str = TOOL0) -> FloatArray:
+    """Poses (N, 4, 4) of ``frame`` for configurations q (N, nq): one pinocchio call each."""
+    data = model.createData()
+    frame_id = model.getFrameId(frame)
+    configs = np.asarray(q, dtype=np.float64).reshape(-1, model.nq)
+    out = np.empty((len(configs), 4, 4))
+    for i, qi in enumerate(configs):
+        pin.framesForwardKinematics(model, data, qi)
+        out[i] = data.oMf[frame_id].homogeneous
+    return out
