@@ -15,6 +15,12 @@ Sources
 * Turn (T): bit ``i`` is set when axis ``A(i+1) < 0``; exactly 0 gives 0.
 * Status (S): see :func:`status_bits` (bit 0 overhead, bit 1 A3 position, bit 2 A5 < 0).
   Status and Turn only matter for PTP motions; LIN/CIRC ignore them on the controller.
+* Status/Turn and :class:`olp.ir.Configuration` (:func:`configuration_from_status_turn`,
+  :func:`status_turn`): S bit 0 is the "back" shoulder, bit 1 the "up" elbow (olp's OPW elbow
+  flag: ``A3 >= atan(|a2| / c3)`` is the wrist centre in front of the lower arm), bit 2 the
+  "flip" wrist (A5 < 0). T bit i asks for A(i+1) in (-inf, 0), a clear bit for [0, inf). T only
+  tells a joint's turn apart where the joint's range lies within (-360°, 360°) (KUKA A4 ±185°
+  and A6 ±350° do): over a wider range two turns of the same sign both fit.
 """
 
 from __future__ import annotations
@@ -27,6 +33,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from olp.diagnostics import Diagnostic
 from olp.geometry import pose_from, rotation_from_zyx, roty, zyx_from_rotation
+from olp.ir import Configuration
+from olp.kinematics.configuration import ArmModel, make_configuration, opw_parameters, wrist_x
 
 FloatArray = NDArray[np.float64]
 
@@ -89,6 +97,46 @@ def status_bits(
     return overhead.astype(np.int64) + 2 * elbow.astype(np.int64) + 4 * flip.astype(np.int64)
 
 
+def a3_threshold(model: ArmModel) -> float:
+    """Controller A3 (rad) at which Status bit 1 changes: the A3 that puts the wrist centre on
+    the line of the lower arm, ``offset3 - atan2(a2, c3)`` = ``atan(|a2| / c3)`` in KUKA's
+    convention (0 when axes 3 and 4 intersect).
+
+    ``model``: OPW parameters or a robot. Derived from the geometry as VENDOR-NOTES give it, not
+    quoted from KUKA (unverified per model). Only defined for an A3 sign of +1 (KUKA's).
+    """
+    params = opw_parameters(model)
+    if params.signs[2] != 1:
+        raise ValueError("a3_threshold: Status bit 1 is defined for KUKA's A3 convention (sign +1)")
+    return params.offsets[2] - math.atan2(params.a2, params.c3)
+
+
+def status_from_joints(model: ArmModel, joints: ArrayLike) -> NDArray[np.int64]:
+    """KUKA Status (S) (...,) of controller joints (..., 6) in rad on ``model`` (OPW parameters
+    or a robot): :func:`status_bits` with the wrist-centre x and A3 threshold of the arm."""
+    q = np.asarray(joints, dtype=np.float64)
+    return status_bits(q, wrist_x(model, q), a3_threshold(model))
+
+
+def status_turn(model: ArmModel, joints: ArrayLike) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """KUKA Status and Turn (each (...,)) of controller joints (..., 6) in rad."""
+    return status_from_joints(model, joints), turn_bits(joints)
+
+
+def configuration_from_status_turn(status: int, turn: int, axes: int = 6) -> Configuration:
+    """The :class:`olp.ir.Configuration` a KRL ``S``/``T`` pair asks for.
+
+    S bit 0: shoulder "back"; bit 1: elbow "up" (clear: "down"); bit 2: wrist "flip"; bits 3
+    and 4 are ignored. T bit i: A(i+1) in (-inf, 0) when set, [0, inf) when clear.
+    """
+    if not 0 <= status < 32 or not 0 <= turn < (1 << axes):
+        raise ValueError(f"KUKA S/T out of range: S {status}, T {turn} ({axes} axes)")
+    ranges = tuple((-math.inf, 0.0) if turn >> i & 1 else (0.0, math.inf) for i in range(axes))
+    return make_configuration(
+        bool(status & 1), not status & 2, bool(status & 4), joint_ranges=ranges
+    )
+
+
 # --------------------------------------------------------------------------------------------
 # Spelling for the KRL post (templates call these as filters)
 
@@ -131,7 +179,18 @@ def legal_name(name: str) -> str:
     return cleaned[:MAX_NAME_LENGTH]
 
 
-TEMPLATE_FILTERS = {"krl_frame": krl_frame, "krl_axis": krl_axis}
+def krl_status_turn(joints: ArrayLike, model: ArmModel) -> str:
+    """``S 2,T 10`` (decimal, as in E6POS values) of controller joints (6,) in rad; a template
+    filter: ``step.joints | krl_status_turn(station.robot)``."""
+    status, turn = status_turn(model, joints)
+    return f"S {int(status)},T {int(turn)}"
+
+
+TEMPLATE_FILTERS = {
+    "krl_frame": krl_frame,
+    "krl_axis": krl_axis,
+    "krl_status_turn": krl_status_turn,
+}
 
 
 def post_diagnostics(compiled: Any) -> list[Diagnostic]:

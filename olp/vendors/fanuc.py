@@ -1,0 +1,230 @@
+"""Fanuc R-30iB (TP / LS) conventions: W, P, R angles, CONFIG, joint convention, flange, names.
+
+Used by frontends and the LS post alike; nothing else in olp knows these rules.
+
+Sources
+-------
+* W, P, R: ``R = Rz(R) · Ry(P) · Rx(W)`` (W about X, P about Y, R about Z, fixed axes), degrees,
+  positions in mm (project vendor notes; the same order as RoboDK's Fanuc post and every
+  published Fanuc LS /POS example seen). Reuses :func:`olp.geometry.rotation_from_zyx`. W and R lie
+  in (-180°, 180°], P in [-90°, 90°]; at P = ±90° (gimbal lock) olp writes W = 0 and puts the
+  rotation into R (olp's choice; what the pendant shows there is unverified).
+* CONFIG ``'F U T, t1, t4, t6'`` (:class:`FanucConfig`):
+
+  - ``F``/``N`` wrist: ``N`` when J5 < 0, ``F`` otherwise (project vendor notes, medium
+    confidence: the usual tool-down pose J5 = -90° reads ``'N U T'``; the test checks that pose
+    is tool-down in olp's Fanuc model). J5 = 0 exactly gives ``F`` (olp's tie rule, unverified).
+    Beware the names: Fanuc's ``N`` ("no flip") is :class:`olp.ir.Configuration`'s
+    ``wrist="flip"``, which is defined as "axis 5 negative in the controller's convention";
+    Fanuc's J5 turns the other way than ABB's axis 5 and KUKA's A5, so the physically usual
+    wrist is J5 < 0 on a Fanuc and axis 5 > 0 on the others.
+  - ``U``/``D`` elbow: olp's elbow flag (wrist centre in front of / behind the line of the lower
+    arm, :mod:`olp.kinematics.configuration`), the meaning of KUKA's S bit 1 and ABB's cfx bit 1.
+    For ``T`` poses it is the geometric elbow up/down (medium confidence). For ``B`` poses the
+    two differ (an arm reaching back with the elbow geometrically above the shoulder-wrist line
+    has its wrist centre behind the lower arm: ``D`` here); which one Fanuc means there is
+    unverified.
+  - ``T``/``B``: wrist centre in front of / behind the J1 axis (project vendor notes).
+  - Turn numbers of J1, J4 and J6: 0 for (-180°, 180°), +1 for [180°, 540°), -1 for
+    (-540°, -180°], and so on symmetrically (:func:`turn_number`). The same rule is in RoboDK's
+    public Fanuc post (``angle_2_turn``). Pinned at the boundaries by the tests.
+
+* Joint convention: the pendant's J3 is measured from the horizontal, so it couples with J2
+  (``J3_model = J3 + J2`` in the ROS-Industrial model, ``J3 = J3_model - J2``). olp's robot
+  kinematics own that conversion (:data:`olp.kinematics.base.FANUC_J2_J3`, applied inside
+  :class:`olp.kinematics.models.OPWKinematics`); every function here takes and returns the
+  *controller's* joints, the numbers the pendant shows and LS joint positions carry. Pass the
+  robot (or its kinematics) as ``model``: bare OPW parameters would read J3 as the model's.
+* What CONFIG cannot say: it carries no turn for J2, J3 and J5. Where a station's J3 range is
+  wider than 360° (the bundled LR Mate 200iC: -142..230°, M-20iA: -185..273°, both modelled
+  without the J2/J3 interaction limit), J3 and J3 ± 360° reach the same pose with the same
+  CONFIG; :func:`olp.kinematics.configuration.satisfies` then admits both and the caller
+  chooses. Which one the controller takes is unverified.
+* Flange: the ROS-Industrial Fanuc descriptions (e.g. ``fanuc_lrmate200ic_support``,
+  ``lrmate200ic_macro.xacro``) define ``tool0`` as the "all-zeros tool frame", i.e. the tool
+  frame the controller uses with an all-zero UTOOL (the faceplate), and a separate X-out
+  ``flange`` link for attaching end effectors. olp's model tool0 is that tool0, so
+  :data:`FLANGE_IN_TOOL0` is the identity. Their ``base`` link is Fanuc's World frame, at the
+  height of J2 (c1 above ``base_link``).
+* Program names: 1-36 characters, a letter first, then A-Z, 0-9 and ``_``, written in upper case
+  (project vendor notes, medium confidence; older controllers accept 8).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from olp.geometry import pose_from, rotation_from_zyx, zyx_from_rotation
+from olp.ir import Configuration
+from olp.kinematics.configuration import ArmModel, branch_flags, make_configuration, snap
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+
+FLANGE_IN_TOOL0: FloatArray = np.eye(4)
+"""Fanuc's faceplate (all-zeros tool frame) is the model's tool0 (ROS-Industrial)."""
+
+TURN_AXES = (0, 3, 5)
+"""Joints (0-based) whose turn numbers CONFIG carries: J1, J4, J6."""
+
+
+# --------------------------------------------------------------------------------------------
+# Orientation
+
+
+def wpr_to_rotation(w: ArrayLike, p: ArrayLike, r: ArrayLike) -> FloatArray:
+    """Rotation matrices (..., 3, 3) ``Rz(R) · Ry(P) · Rx(W)`` from W, P, R in **radians**."""
+    return rotation_from_zyx(r, p, w)
+
+
+def rotation_to_wpr(rotation: ArrayLike) -> FloatArray:
+    """(W, P, R) in radians, shape (..., 3), of rotation matrices (..., 3, 3).
+
+    W and R in (-pi, pi], P in [-pi/2, pi/2]; at P = ±pi/2 W is 0 and R carries the rotation.
+    """
+    return zyx_from_rotation(rotation)[..., ::-1]
+
+
+def xyzwpr_to_pose(xyzwpr: ArrayLike) -> FloatArray:
+    """Poses (..., 4, 4) in metres from X, Y, Z (mm) and W, P, R (deg), shape (..., 6)."""
+    v = np.asarray(xyzwpr, dtype=np.float64)
+    rot = wpr_to_rotation(*np.radians(np.moveaxis(v[..., 3:6], -1, 0)))
+    return pose_from(rot, v[..., :3] / 1000.0)
+
+
+def pose_to_xyzwpr(pose: ArrayLike) -> FloatArray:
+    """X, Y, Z (mm) and W, P, R (deg), shape (..., 6), from poses (..., 4, 4) in metres."""
+    t = np.asarray(pose, dtype=np.float64)
+    return np.concatenate([t[..., :3, 3] * 1000.0, np.degrees(rotation_to_wpr(t[..., :3, :3]))], -1)
+
+
+# --------------------------------------------------------------------------------------------
+# Configuration
+
+
+def turn_number(angles: ArrayLike) -> IntArray:
+    """Fanuc turn numbers (...,) of joint angles (...,) in rad.
+
+    0 for (-180°, 180°), +1 for [180°, 540°), -1 for (-540°, -180°], +2 for [540°, 900°) ...:
+    ``sign(q) · floor((|q| + 180°) / 360°)``. Angles within 1e-12 rad of an odd multiple of 180°
+    count as on it.
+    """
+    q = snap(angles, math.pi)
+    return (np.sign(q) * np.floor((np.abs(q) + math.pi) / (2 * math.pi))).astype(np.int64)
+
+
+def turn_range(turn: int) -> tuple[float, float]:
+    """The joint range (rad) of a turn number: ``((2n - 1)·180°, (2n + 1)·180°)``; which end is
+    closed follows :func:`turn_number` (the end nearer 0 is open, except for 0 where both are)."""
+    return ((2 * turn - 1) * math.pi, (2 * turn + 1) * math.pi)
+
+
+@dataclass(frozen=True, slots=True)
+class FanucConfig:
+    """A Fanuc CONFIG value, e.g. ``'N U T, 0, 0, 0'``.
+
+    ``flip``: ``F`` (J5 >= 0) rather than ``N`` (J5 < 0). ``up``: ``U`` rather than ``D``.
+    ``front``: ``T`` (wrist centre in front of the J1 axis) rather than ``B``.
+    ``turns``: turn numbers of J1, J4, J6.
+    """
+
+    flip: bool
+    up: bool
+    front: bool
+    turns: tuple[int, int, int] = (0, 0, 0)
+
+    def __str__(self) -> str:
+        letters = (
+            f"{'F' if self.flip else 'N'} {'U' if self.up else 'D'} {'T' if self.front else 'B'}"
+        )
+        return f"{letters}, {self.turns[0]}, {self.turns[1]}, {self.turns[2]}"
+
+    @classmethod
+    def parse(cls, text: str) -> FanucConfig:
+        """Read ``'N U T, 0, -1, 0'`` (quotes optional, any spacing and letter case)."""
+        match = _CONFIG.fullmatch(text.strip().strip("'").strip())
+        if match is None:
+            raise ValueError(f"not a Fanuc CONFIG value: {text!r} (expected e.g. 'N U T, 0, 0, 0')")
+        wrist, elbow, shoulder, t1, t4, t6 = match.groups()
+        turns = (int(t1), int(t4), int(t6))
+        return cls(wrist.upper() == "F", elbow.upper() == "U", shoulder.upper() == "T", turns)
+
+
+_CONFIG = re.compile(
+    r"([FN])\s*([UD])\s*([TB])\s*,\s*([+-]?\d+)\s*,\s*([+-]?\d+)\s*,\s*([+-]?\d+)", re.IGNORECASE
+)
+
+
+def config_from_joints(model: ArmModel, joints: ArrayLike) -> FanucConfig:
+    """The CONFIG of controller joints (6,) in rad on ``model`` (OPW parameters or a robot)."""
+    q = np.asarray(joints, dtype=np.float64)
+    if q.shape != (6,):
+        raise ValueError(f"config_from_joints: expected joints of shape (6,), got {q.shape}")
+    flags = branch_flags(model, q)
+    t1, t4, t6 = (int(t) for t in turn_number(q[list(TURN_AXES)]))
+    return FanucConfig(
+        not bool(flags.flip), not bool(flags.down), not bool(flags.back), (t1, t4, t6)
+    )
+
+
+def configuration_from_config(config: FanucConfig | str) -> Configuration:
+    """The :class:`olp.ir.Configuration` a CONFIG asks for: ``F`` is ``wrist="noflip"`` (J5 >=
+    0), ``N`` is ``"flip"``; turn numbers become ranges of J1, J4 and J6 (:func:`turn_range`)."""
+    c = FanucConfig.parse(config) if isinstance(config, str) else config
+    ranges: list[tuple[float, float] | None] = [None] * 6
+    for axis, turn in zip(TURN_AXES, c.turns, strict=True):
+        ranges[axis] = turn_range(turn)
+    return make_configuration(not c.front, not c.up, not c.flip, joint_ranges=tuple(ranges))
+
+
+# --------------------------------------------------------------------------------------------
+# Spelling for the LS post
+
+POSITION_DECIMALS = 3
+"""mm for X, Y, Z and deg for W, P, R and joints, as LS files carry them."""
+
+MAX_NAME_LENGTH = 36
+"""Program names: 1-36 characters (medium confidence; older controllers accept 8)."""
+
+
+def _num(value: float, decimals: int = POSITION_DECIMALS) -> str:
+    text = f"{float(value):.{decimals}f}"
+    return text[1:] if text.startswith("-") and float(text) == 0.0 else text
+
+
+def ls_xyzwpr(pose: ArrayLike) -> list[str]:
+    """X, Y, Z (mm) and W, P, R (deg) of a pose (4, 4) in metres as 6 strings (3 decimals)."""
+    return [_num(v) for v in pose_to_xyzwpr(pose)]
+
+
+def ls_joints(joints: ArrayLike) -> list[str]:
+    """J1..J6 in degrees (3 decimals) from controller joints (6,) in rad."""
+    return [_num(v) for v in np.degrees(np.asarray(joints, dtype=np.float64))]
+
+
+def legal_name(name: str) -> str:
+    """A legal program name: upper case A-Z, 0-9 and ``_``, a letter first (``P`` is put in front
+    otherwise), at most 36 characters."""
+    cleaned = "".join(
+        ch.upper() if (ch.isascii() and (ch.isalnum() or ch == "_")) else "_" for ch in name
+    )
+    if not cleaned or not cleaned[0].isalpha():
+        cleaned = "P" + cleaned
+    return cleaned[:MAX_NAME_LENGTH]
+
+
+def _config_filter(joints: ArrayLike, robot: ArmModel) -> str:
+    """Template filter: ``joints | fanuc_config(robot)`` gives ``N U T, 0, 0, 0``."""
+    return str(config_from_joints(robot, joints))
+
+
+TEMPLATE_FILTERS = {
+    "fanuc_config": _config_filter,
+    "ls_xyzwpr": ls_xyzwpr,
+    "ls_joints": ls_joints,
+}

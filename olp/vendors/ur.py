@@ -1,0 +1,119 @@
+"""Universal Robots (URScript) conventions: rotation vectors, pose values, flange frame, names.
+
+Used by frontends and the URScript post alike; nothing else in olp knows these rules.
+
+Sources
+-------
+* Poses ``p[x, y, z, rx, ry, rz]``: metres and a rotation vector (unit axis times angle, rad) in
+  the controller's Base frame (URScript manual, ``p[...]`` pose literals; project vendor notes).
+  :func:`rotvec_from_rotation` reuses :func:`olp.geometry.rotation_log`, which is exact at 180°
+  (where ``angle / (2 sin angle)`` divides by zero, the classic rotation-vector crash): there
+  ``v`` and ``-v`` are the same rotation, and olp writes the one whose largest component is
+  positive (olp's choice; the controller accepts either). Angles lie in [0, pi].
+* Flange: the URDFs of Universal Robots' ROS descriptions (``ur_macro.xacro``) name ``tool0``
+  the "all-zeros tool frame", matching the controller's tool flange frame (TCP with a zero
+  offset, Z out of the flange); olp's model tool0 is that frame, so :data:`FLANGE_IN_TOOL0` is
+  the identity. (The same files put the controller's Base frame at ``base``, ``base_link``
+  turned 180° about Z; the UR kinematics must report tool0 in that frame.)
+* Configuration: URScript has no configuration bits. For ``movel``/``movep``/``movec`` and for
+  ``movej`` given a pose, the controller picks the IK solution nearest to the current joints
+  (URScript manual on ``movej`` with a pose; paraphrased, not re-checked). Consequences for
+  olp: a joint move is written with the planned joint values (``movej([q1, ..., q6])``), never
+  with a pose, so the planned branch and turn are what runs; a linear move needs no
+  configuration because it continues from the joints the previous move ended in, which resolve
+  already checked stay in one branch.
+* Program (``def``) names: letters, digits and ``_``, a letter first, not a keyword (Python-like
+  syntax; the exact rules and any length limit are unverified).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from olp.geometry import pose_from, rotation_exp, rotation_log
+
+FloatArray = NDArray[np.float64]
+
+FLANGE_IN_TOOL0: FloatArray = np.eye(4)
+"""UR's tool flange frame (Z out) is the model's tool0."""
+
+HAS_CONFIGURATION = False
+"""URScript carries no configuration bits: joint moves are written as joint targets."""
+
+_AT_PI = 1e-12
+"""A rotation angle this close to pi is exactly 180° for the sign rule."""
+
+
+def rotvec_from_rotation(rotation: ArrayLike) -> FloatArray:
+    """Rotation vectors (..., 3) (axis times angle in [0, pi], rad) of rotations (..., 3, 3).
+
+    At exactly 180° the vector with a positive largest component is returned.
+    """
+    v = rotation_log(rotation)
+    angle = np.linalg.norm(v, axis=-1, keepdims=True)
+    largest = np.take_along_axis(v, np.argmax(np.abs(v), axis=-1)[..., None], axis=-1)
+    flip = (angle > np.pi - _AT_PI) & (largest < 0)
+    return np.where(flip, -v, v) + 0.0
+
+
+def rotation_from_rotvec(rotvec: ArrayLike) -> FloatArray:
+    """Rotation matrices (..., 3, 3) from rotation vectors (..., 3) in rad (any length)."""
+    return rotation_exp(rotvec)
+
+
+def pose_to_ur(pose: ArrayLike) -> FloatArray:
+    """``[x, y, z, rx, ry, rz]`` (..., 6), metres and rad, from poses (..., 4, 4) in metres."""
+    t = np.asarray(pose, dtype=np.float64)
+    return np.concatenate([t[..., :3, 3], rotvec_from_rotation(t[..., :3, :3])], axis=-1)
+
+
+def ur_to_pose(values: ArrayLike) -> FloatArray:
+    """Poses (..., 4, 4) in metres from ``[x, y, z, rx, ry, rz]`` (..., 6), metres and rad."""
+    v = np.asarray(values, dtype=np.float64)
+    return pose_from(rotation_from_rotvec(v[..., 3:6]), v[..., :3])
+
+
+# --------------------------------------------------------------------------------------------
+# Spelling for the URScript post
+
+POSITION_DECIMALS = 6
+"""m: 1 µm."""
+ANGLE_DECIMALS = 6
+"""rad, for rotation vectors and joints: 1e-6 rad is 1 µm at 1 m."""
+
+_KEYWORDS = """
+def end if elif else while for return thread run kill halt break continue pass global local
+and or not xor True False
+"""
+KEYWORDS = frozenset(_KEYWORDS.split())
+"""URScript words a program name must not be (Python-like; unverified list)."""
+
+
+def _num(value: float, decimals: int) -> str:
+    text = f"{float(value):.{decimals}f}"
+    return text[1:] if text.startswith("-") and float(text) == 0.0 else text
+
+
+def ur_pose(pose: ArrayLike) -> str:
+    """``p[x, y, z, rx, ry, rz]`` from a pose (4, 4) in metres."""
+    v = pose_to_ur(pose)
+    values = [_num(x, POSITION_DECIMALS) for x in v[:3]] + [_num(x, ANGLE_DECIMALS) for x in v[3:]]
+    return "p[" + ", ".join(values) + "]"
+
+
+def ur_joints(joints: ArrayLike) -> str:
+    """``[q1, ..., q6]`` in rad (the ``movej`` joint target) from controller joints (6,) in rad."""
+    return "[" + ", ".join(_num(x, ANGLE_DECIMALS) for x in np.asarray(joints, float)) + "]"
+
+
+def legal_name(name: str) -> str:
+    """A legal ``def`` name: ASCII letters, digits and ``_``, a letter first (``p`` is put in front
+    otherwise); a keyword gets a trailing ``_``."""
+    cleaned = "".join(ch if (ch.isascii() and (ch.isalnum() or ch == "_")) else "_" for ch in name)
+    if not cleaned or not cleaned[0].isalpha():
+        cleaned = "p" + cleaned
+    return cleaned + "_" if cleaned in KEYWORDS else cleaned
+
+
+TEMPLATE_FILTERS = {"ur_pose": ur_pose, "ur_joints": ur_joints}
