@@ -3,19 +3,30 @@
 Stable JSON keys (kept from the first release on): ``program``, ``post``, ``files``,
 ``cycle_time_s``, ``instructions`` (``index``, ``kind``, ``source``, ``joints_deg`` for motions,
 ``time_s``) and ``diagnostics`` (``severity``, ``kind``, ``message``, ``source``). New keys may be
-added; these are not renamed or removed.
+added; these are not renamed or removed. Added since: ``path_length_m`` (total and per motion,
+TCP travel) and ``start_s`` per instruction (its start time in the cycle).
+
+The timing tables of ``olp time`` (:func:`timing_summary`, :func:`timing_table`,
+:func:`sweep_table`) live here too.
 """
 
 from __future__ import annotations
 
 import json
-from typing import Any
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from olp.api import BuildResult
 from olp.errors import line_of
 from olp.ir import is_motion
+
+if TYPE_CHECKING:
+    from numpy.typing import NDArray
+
+    from olp.passes.resolve import CompiledProgram
 
 SCHEMA_VERSION = 1
 
@@ -24,14 +35,17 @@ def report_dict(result: BuildResult) -> dict[str, Any]:
     """The JSON-ready report of a build."""
     compiled = result.compiled
     instructions = []
+    start = 0.0
     for step in compiled.steps:
         ins = step.instruction
         item: dict[str, Any] = {
             "index": step.index,
             "kind": ins.kind,
             "source": ins.span.location,
+            "start_s": round(start, 6),
             "time_s": round(step.duration, 6),
         }
+        start += step.duration
         if is_motion(ins):
             item["joints_deg"] = (
                 [round(float(v), 6) for v in np.degrees(step.joints)]
@@ -51,6 +65,7 @@ def report_dict(result: BuildResult) -> dict[str, Any]:
         "ok": result.ok,
         "files": [str(p) for p in result.written],
         "cycle_time_s": round(compiled.cycle_time, 6) if compiled.ok else None,
+        "path_length_m": round(_path_length(compiled), 9) if compiled.ok else None,
         "instructions": instructions,
         "diagnostics": [d.to_json() for d in result.diagnostics],
     }
@@ -76,7 +91,11 @@ def summary(result: BuildResult) -> str:
         ("reachability", _verdict(len(motions), len(resolved), errors)),
         (
             "cycle time",
-            f"{compiled.cycle_time:.2f} s (estimate; zones timed as stops)" if compiled.ok else "-",
+            f"{compiled.cycle_time:.2f} s ({_timing_note(compiled)})" if compiled.ok else "-",
+        ),
+        (
+            "path length",
+            f"{_path_length(compiled) * 1000:.1f} mm of TCP travel" if compiled.ok else "-",
         ),
         ("diagnostics", f"{len(errors)} errors, {len(warnings)} warnings"),
     ]
@@ -84,6 +103,80 @@ def summary(result: BuildResult) -> str:
         rows.append(("written", ", ".join(str(p) for p in result.written)))
     width = max(len(k) for k, _ in rows)
     return "\n".join(f"{k.ljust(width)}  {v}" for k, v in rows)
+
+
+def _path_length(compiled: CompiledProgram) -> float:
+    return float(sum(step.path_length for step in compiled.steps))
+
+
+def _timing_note(compiled: CompiledProgram) -> str:
+    """How to read the cycle time: time-optimal, or an upper bound where zones became stops."""
+    stops = sum(1 for d in compiled.diagnostics if d.kind == "zone_stop")
+    if stops:
+        return f"estimate; upper bound: {stops} zone{'s' * (stops > 1)} timed as exact stops"
+    return "estimate: time-optimal under the station's limits"
+
+
+def timing_summary(compiled: CompiledProgram) -> str:
+    """Program, station, cycle time and path length, one per line (``olp time``)."""
+    rows = [
+        ("program", f"{compiled.program.name} ({compiled.program.source})"),
+        ("station", f"{compiled.station.name} ({compiled.station.robot.name})"),
+        ("cycle time", f"{compiled.cycle_time:.3f} s ({_timing_note(compiled)})"),
+        ("path length", f"{_path_length(compiled) * 1000:.1f} mm of TCP travel"),
+    ]
+    width = max(len(k) for k, _ in rows)
+    return "\n".join(f"{k.ljust(width)}  {v}" for k, v in rows)
+
+
+def timing_table(compiled: CompiledProgram) -> str:
+    """Per instruction: index, kind, source file:line, TCP path length (mm), time (s), with a
+    total line."""
+    header = ("#", "kind", "source", "path mm", "time s")
+    rows = [
+        (
+            str(step.index),
+            step.instruction.kind,
+            f"{Path(step.instruction.span.file).name}:{step.instruction.span.line}",
+            f"{step.path_length * 1000:.2f}" if is_motion(step.instruction) else "",
+            f"{step.duration:.3f}",
+        )
+        for step in compiled.steps
+    ]
+    total = ("", "total", "", f"{_path_length(compiled) * 1000:.2f}", f"{compiled.cycle_time:.3f}")
+    return _columns([header, *rows, total], right=(0, 3, 4))
+
+
+def sweep_table(
+    linear: Sequence[float | None], joint: Sequence[float | None], times: NDArray[Any]
+) -> str:
+    """Cycle times (L, J) s as a table: rows linear speed (mm/s), columns joint speed (%);
+    ``None`` speeds are the programmed ones, NaN times (not timed) show as ``-``."""
+    corner = "mm/s \\ %"
+    header = [corner, *("prog." if p is None else f"{p * 100:g}" for p in joint)]
+    rows = [
+        ["prog." if v is None else f"{v * 1000:g}", *(_seconds(t) for t in line)]
+        for v, line in zip(linear, times, strict=True)
+    ]
+    title = "cycle time (s): rows TCP speed of path moves (mm/s), columns joint speed (%)"
+    return title + "\n" + _columns([header, *rows], right=tuple(range(len(header))))
+
+
+def _seconds(value: float) -> str:
+    return "-" if not np.isfinite(value) else f"{value:.2f}"
+
+
+def _columns(rows: Sequence[Sequence[str]], right: tuple[int, ...]) -> str:
+    """Rows of cells as aligned text columns (right-aligned where listed), two spaces apart."""
+    widths = [max(len(row[i]) for row in rows) for i in range(len(rows[0]))]
+    lines = []
+    for row in rows:
+        cells = [
+            cell.rjust(w) if i in right else cell.ljust(w)
+            for i, (cell, w) in enumerate(zip(row, widths, strict=True))
+        ]
+        lines.append("  ".join(cells).rstrip())
+    return "\n".join(lines)
 
 
 def _verdict(total: int, resolved: int, errors: list[Any]) -> str:

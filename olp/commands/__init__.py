@@ -11,5 +11,5 @@ and is listed in :data:`COMMANDS`. Modules import heavy packages inside ``run`` 
 
 from __future__ import annotations
 
-COMMANDS: tuple[str, ...] = ("build", "check", "posts", "robots", "schema")
+COMMANDS: tuple[str, ...] = ("build", "check", "posts", "robots", "schema", "time")
 """Command module names under :mod:`olp.commands`, in ``olp --help`` order."""

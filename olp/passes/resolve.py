@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
@@ -36,9 +37,12 @@ from olp.ir import (
     Tool,
     is_motion,
 )
-from olp.kinematics.opw import turn_variants
+from olp.kinematics.base import turn_variants
 from olp.passes.sampling import SegmentSamples, sample_segments
 from olp.station.model import Robot, Station
+
+if TYPE_CHECKING:
+    from olp.trajectory import Segment
 
 FloatArray = NDArray[np.float64]
 
@@ -69,8 +73,9 @@ class Step:
     """One instruction as compiled.
 
     ``joints``: joints at the end of a motion, (6,) rad; ``path``: the sampled joint path of a
-    motion including its start, (S, 6) rad; ``duration`` (s) and ``path_length`` (m of TCP travel)
-    are filled by the timing pass.
+    motion including its start, (S, 6) rad; ``duration`` (s), ``path_length`` (m of TCP travel)
+    and ``trajectory`` (the timed motion, to sample joints over time) are filled by the timing
+    pass.
     """
 
     index: int
@@ -81,6 +86,7 @@ class Step:
     frame: Frame | None = None
     duration: float = 0.0
     path_length: float = 0.0
+    trajectory: Segment | None = None
     skipped: bool = False
 
 
@@ -233,7 +239,8 @@ def _batch_path(
     targets = np.stack([_world(frame) @ ins.target.pose for ins, _, frame in chunk])  # type: ignore[union-attr]
     start = robot.flange_poses(state.q) @ tool_pose
     samples = sample_segments(start, targets, opts.step_m, opts.step_rad)
-    sols = robot.solve(samples.poses @ inv(tool_pose))[:, robot.branch_of(state.q), :]
+    flanges = samples.poses @ inv(tool_pose)
+    sols = robot.solve(flanges, seed=state.q)[:, robot.branch_of(state.q), :]
     path = np.vstack([state.q[None], _unwrap(state.q, sols)])
     ends = samples.ends + 1
     with np.errstate(invalid="ignore"):
@@ -485,7 +492,7 @@ def _linear_path(
     fractions = np.linspace(0.0, 1.0, count + 1)
     flanges = interpolate_poses(tcp_start, tcp_end, fractions) @ inv(tool.pose)
     branch = robot.branch_of(state.q)
-    sols = robot.solve(flanges)[:, branch, :]
+    sols = robot.solve(flanges, seed=state.q)[:, branch, :]
     if np.any(~np.isfinite(sols)):
         first = int(np.argmax(~np.all(np.isfinite(sols), axis=-1)))
         msg = (

@@ -1,0 +1,184 @@
+"""``olp time STATION PROGRAM``: the estimated cycle time, per instruction and over speed sweeps;
+the joint trajectory as CSV and as a plot.
+
+A sweep overrides the programmed speeds of *every* motion: ``--sweep-linear`` sets the TCP speed
+of every path move (LIN, CIRC), ``--sweep-joint`` the joint speed (% of each axis' maximum) of
+every joint move. Accelerations and orientation-speed limits stay as programmed. Without one of
+the two options, that dimension keeps the programmed speeds.
+
+Exit codes as for ``olp build``: 0 timed, 1 the program has errors, 2 bad input.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from collections.abc import Callable, Mapping
+from typing import TYPE_CHECKING
+
+from olp.commands.check import add_check_options, resolve_options
+from olp.commands.common import EXIT_OK, EXIT_PROGRAM_ERRORS, print_diagnostics, require_files
+from olp.errors import UsageError
+
+if TYPE_CHECKING:
+    from olp.passes.resolve import CompiledProgram
+
+NAME = "time"
+HELP = "estimate a program's cycle time: per instruction, speed sweeps, trajectory CSV and plot"
+
+OVERRIDABLE = ("set_output", "wait_input", "call", "comment")
+"""Instruction kinds whose default time ``--time KIND=SECONDS`` may override."""
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("station", help="station YAML file")
+    parser.add_argument("program", help="program file")
+    parser.add_argument(
+        "--sweep-linear",
+        metavar="MM_S,...",
+        help="TCP speeds (mm/s) for every path move, e.g. 50,100,200: a cycle-time table",
+    )
+    parser.add_argument(
+        "--sweep-joint",
+        metavar="PCT,...",
+        help="joint speeds (%% of the axes' maximum) for every joint move, e.g. 25,50,100",
+    )
+    parser.add_argument("--trajectory", metavar="CSV", help="write the sampled trajectory here")
+    parser.add_argument(
+        "--dt", type=float, default=0.01, help="trajectory sampling step in s (default: 0.01)"
+    )
+    parser.add_argument("--plot", metavar="PNG", help="plot joint positions and velocities here")
+    parser.add_argument(
+        "--time",
+        action="append",
+        default=[],
+        metavar="KIND=SECONDS",
+        help="time charged for an instruction kind (set_output, wait_input, call, comment) or a "
+        "named call (call:NAME); repeatable, e.g. --time call:SprayOn=1.5",
+    )
+    add_check_options(parser)
+    parser.add_argument(
+        "-q", "--quiet", action="store_true", help="results only: no table, progress or warnings"
+    )
+
+
+def run(args: argparse.Namespace) -> int:
+    from olp.api import load_station, parse
+    from olp.passes.resolve import resolve
+    from olp.passes.timing import time_program
+
+    require_files(args.station, args.program)
+    linear = _speed_list(args.sweep_linear, "--sweep-linear", "mm/s", 1e-3)
+    joint = _speed_list(args.sweep_joint, "--sweep-joint", "%", 1e-2, upper=1.0)
+    other_times = parse_times(args.time)
+    if not (math.isfinite(args.dt) and args.dt > 0):
+        raise UsageError(f"--dt must be a positive number of seconds, got {args.dt}")
+    if args.plot:
+        from olp.trajectory import require_matplotlib
+
+        require_matplotlib()
+    station = load_station(args.station)
+    parsed = parse(args.program)
+    compiled = resolve(parsed.program, station, resolve_options(args))
+    if compiled.ok:
+        compiled = time_program(compiled, other_times)
+    print_diagnostics(parsed.notes + compiled.diagnostics, args.program, quiet=args.quiet)
+    if not compiled.ok:
+        return EXIT_PROGRAM_ERRORS
+    _print_results(compiled, args.quiet)
+    if linear or joint:
+        _print_sweep(compiled, linear, joint, other_times, args.quiet)
+    _write_outputs(compiled, args)
+    return EXIT_OK
+
+
+def _speed_list(
+    text: str | None, option: str, unit: str, to_si: float, upper: float | None = None
+) -> list[float]:
+    """Comma-separated positive speeds in ``unit``, converted by ``to_si`` (empty if absent)."""
+    if text is None:
+        return []
+    try:
+        values = [float(part) * to_si for part in text.split(",")]
+    except ValueError:
+        msg = f"{option}: expected numbers in {unit} separated by commas, got {text!r}"
+        raise UsageError(msg) from None
+    bad = [v / to_si for v in values if not (math.isfinite(v) and v > 0)]
+    bad += [v / to_si for v in values if upper is not None and v > upper]
+    if bad:
+        limit = f" and at most {upper / to_si:g}" if upper is not None else ""
+        raise UsageError(f"{option}: speeds must be > 0{limit} {unit}, got {bad[0]:g}")
+    return values
+
+
+def parse_times(items: list[str]) -> dict[str, float]:
+    """``KIND=SECONDS`` items as a time table for :func:`olp.passes.timing.time_program`."""
+    table = {}
+    for item in items:
+        kind, sep, value = item.partition("=")
+        kind = kind.strip()
+        if not sep or not (kind in OVERRIDABLE or (kind.startswith("call:") and kind[5:])):
+            known = ", ".join(OVERRIDABLE)
+            raise UsageError(
+                f"--time {item!r}: expected KIND=SECONDS, KIND one of {known}, call:NAME"
+            )
+        try:
+            seconds = float(value)
+        except ValueError:
+            raise UsageError(f"--time {item!r}: {value!r} is not a number of seconds") from None
+        if not (math.isfinite(seconds) and seconds >= 0):
+            raise UsageError(f"--time {item!r}: the time must be >= 0 s")
+        table[kind] = seconds
+    return table
+
+
+def _print_results(compiled: CompiledProgram, quiet: bool) -> None:
+    from olp.report import timing_summary, timing_table
+
+    print(timing_summary(compiled))
+    if not quiet:
+        print()
+        print(timing_table(compiled))
+
+
+def _print_sweep(
+    compiled: CompiledProgram,
+    linear: list[float],
+    joint: list[float],
+    other_times: Mapping[str, float],
+    quiet: bool,
+) -> None:
+    from olp.passes.timing import speed_sweep
+    from olp.report import sweep_table
+
+    rows: list[float | None] = list(linear) or [None]
+    columns: list[float | None] = list(joint) or [None]
+    show = not quiet and sys.stderr.isatty()
+    table = speed_sweep(compiled, rows, columns, other_times, progress=_progress if show else None)
+    if show:
+        print("\r\033[K", end="", file=sys.stderr, flush=True)
+    print()
+    print(sweep_table(rows, columns, table))
+
+
+def _progress(done: int, total: int) -> None:
+    print(f"\rtiming speeds {done}/{total}", end="", file=sys.stderr, flush=True)
+
+
+def _write_outputs(compiled: CompiledProgram, args: argparse.Namespace) -> None:
+    if not (args.trajectory or args.plot):
+        return
+    from olp.trajectory import instruction_starts, plot_trajectory, sample_program, write_csv
+
+    sampled = sample_program(compiled, args.dt)
+    writers: dict[str, Callable[[str], object]] = {
+        "trajectory": lambda path: write_csv(sampled, path),
+        "plot": lambda path: plot_trajectory(sampled, path, instruction_starts(compiled)),
+    }
+    for option, write in writers.items():
+        path = getattr(args, option)
+        if path:
+            write(path)
+            if not args.quiet:
+                print(f"written: {path}")
