@@ -7,16 +7,20 @@ Stages, each a plain function: :func:`load_station`, :func:`parse` (file -> ir.P
 from __future__ import annotations
 
 import builtins
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING, Protocol
 
 from olp.diagnostics import Diagnostic, has_errors
 from olp.errors import UsageError
-from olp.ir import Program
+from olp.ir import Program, SourceSpan
 from olp.passes.resolve import CompiledProgram, ResolveOptions, resolve
 from olp.station.loader import load_station as _load_station
 from olp.station.model import Station
+
+if TYPE_CHECKING:
+    from olp.frontends.csv import CsvOptions
 
 
 def load_station(path: str | Path) -> Station:
@@ -32,20 +36,88 @@ class ParsedProgram:
     notes: tuple[Diagnostic, ...] = ()
 
 
-def parse(path: str | Path) -> ParsedProgram:
-    """Read a program file; the frontend is chosen by suffix (``.src`` KRL)."""
+def parse(
+    path: str | Path,
+    *,
+    station: Station | None = None,
+    params: Mapping[str, object] | None = None,
+    csv_options: CsvOptions | None = None,
+) -> ParsedProgram:
+    """Read a program file; the frontend is chosen by suffix (see :data:`FRONTENDS`).
+
+    ``station``: what CSV and Python programs may consult (tools and frames by name, the home
+    position, feasibility questions); ``params``: ``--set`` values for a Python program;
+    ``csv_options``: how to read a CSV toolpath. Options a frontend does not take are a
+    :class:`UsageError` rather than silently unused.
+    """
     path = Path(path)
     suffix = path.suffix.lower()
-    if suffix == ".src":
-        from olp.frontends.krl import load_krl
+    frontend = FRONTENDS.get(suffix)
+    if frontend is None:
+        known = ", ".join(FRONTENDS)
+        raise UsageError(f"{path}: unknown program type {suffix!r} (supported: {known})")
+    if params and suffix != ".py":
+        raise UsageError(f"--set parameters are for Python programs, not {suffix} files")
+    if csv_options is not None and suffix != ".csv":
+        raise UsageError(f"CSV options are for .csv toolpaths, not {suffix} files")
+    return frontend(path, _ParseContext(station, params or {}, csv_options))
 
-        result = load_krl(path)
-        notes = tuple(
-            Diagnostic("info", "ignored", f"line not lowered: {item.reason}", item.span)
-            for item in result.ignored
-        )
-        return ParsedProgram(result.program, notes)
-    raise UsageError(f"{path}: unknown program type {suffix!r} (supported: .src)")
+
+@dataclass(frozen=True, slots=True)
+class _ParseContext:
+    station: Station | None
+    params: Mapping[str, object]
+    csv_options: CsvOptions | None
+
+
+def _parse_krl(path: Path, _context: _ParseContext) -> ParsedProgram:
+    from olp.frontends.krl import load_krl
+
+    result = load_krl(path)
+    return ParsedProgram(result.program, _ignored_notes(result.ignored))
+
+
+def _parse_csv(path: Path, context: _ParseContext) -> ParsedProgram:
+    from olp.frontends.csv import load_csv
+
+    result = load_csv(path, context.csv_options, context.station)
+    return ParsedProgram(result.program, _ignored_notes(result.ignored))
+
+
+def _parse_dsl(path: Path, context: _ParseContext) -> ParsedProgram:
+    from olp.frontends.dsl import load_dsl
+
+    result = load_dsl(path, context.station, context.params)
+    warnings = tuple(
+        Diagnostic("warning", "program", item.message, item.span) for item in result.warnings
+    )
+    return ParsedProgram(result.program, _ignored_notes(result.ignored) + warnings)
+
+
+class _Ignored(Protocol):
+    """What every frontend reports for a line it read but did not lower."""
+
+    @property
+    def span(self) -> SourceSpan: ...
+
+    @property
+    def reason(self) -> str: ...
+
+
+def _ignored_notes(ignored: Sequence[_Ignored]) -> tuple[Diagnostic, ...]:
+    """Info diagnostics for what a frontend read but did not lower."""
+    return tuple(
+        Diagnostic("info", "ignored", f"line not lowered: {item.reason}", item.span)
+        for item in ignored
+    )
+
+
+FRONTENDS: dict[str, Callable[[Path, _ParseContext], ParsedProgram]] = {
+    ".src": _parse_krl,
+    ".csv": _parse_csv,
+    ".py": _parse_dsl,
+}
+"""Program file suffix -> frontend."""
 
 
 def compile(
@@ -79,10 +151,16 @@ def build(
     post: str = "kuka",
     out_dir: str | Path | None = None,
     name: str | None = None,
+    *,
+    options: ResolveOptions | None = None,
+    params: Mapping[str, object] | None = None,
+    csv_options: CsvOptions | None = None,
 ) -> BuildResult:
     """Compile ``program`` on ``station`` and render it through ``post``.
 
-    Files are written to ``out_dir`` (if given) only when no error diagnostic remains.
+    ``options`` set the checks (e.g. ``ResolveOptions(skip_unreachable=True)``); ``params``
+    and ``csv_options`` go to :func:`parse` when ``program`` is a file. Files are written to
+    ``out_dir`` (if given) only when no error diagnostic remains.
     """
     from olp.post import find_post, render, write_files
 
@@ -90,10 +168,10 @@ def build(
         station = load_station(station)
     notes: tuple[Diagnostic, ...] = ()
     if not isinstance(program, Program):
-        parsed = parse(program)
+        parsed = parse(program, station=station, params=params, csv_options=csv_options)
         program, notes = parsed.program, parsed.notes
     manifest = find_post(post)
-    compiled = compile(program, station)
+    compiled = compile(program, station, options)
     diagnostics = notes + compiled.diagnostics
     if not compiled.ok:
         return BuildResult(compiled, manifest.name, diagnostics)

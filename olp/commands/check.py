@@ -9,7 +9,13 @@ import argparse
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from olp.commands.common import EXIT_OK, EXIT_PROGRAM_ERRORS, print_diagnostics, require_files
+from olp.commands.common import (
+    EXIT_OK,
+    EXIT_PROGRAM_ERRORS,
+    parse_program,
+    print_diagnostics,
+    require_files,
+)
 
 if TYPE_CHECKING:
     from olp.api import BuildResult
@@ -26,6 +32,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--report", help="write a JSON report to this file")
     parser.add_argument("--sarif", help="write the diagnostics as SARIF 2.1.0 to this file")
     parser.add_argument("-q", "--quiet", action="store_true", help="print errors only")
+    from olp.commands.build import add_program_options
+
+    add_program_options(parser)
 
 
 def add_check_options(parser: argparse.ArgumentParser) -> None:
@@ -53,12 +62,12 @@ def resolve_options(args: argparse.Namespace) -> ResolveOptions:
 
 
 def run(args: argparse.Namespace) -> int:
-    from olp.api import BuildResult, compile, load_station, parse
+    from olp.api import BuildResult, compile, load_station
     from olp.report import summary
 
     require_files(args.station, args.program)
     station = load_station(args.station)
-    parsed = parse(args.program)
+    parsed = parse_program(args, station)
     compiled = compile(parsed.program, station, resolve_options(args))
     result = BuildResult(compiled, "-", parsed.notes + compiled.diagnostics)
     print_diagnostics(result.diagnostics, args.program, quiet=args.quiet)

@@ -18,7 +18,13 @@ from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING
 
 from olp.commands.check import add_check_options, resolve_options
-from olp.commands.common import EXIT_OK, EXIT_PROGRAM_ERRORS, print_diagnostics, require_files
+from olp.commands.common import (
+    EXIT_OK,
+    EXIT_PROGRAM_ERRORS,
+    parse_program,
+    print_diagnostics,
+    require_files,
+)
 from olp.errors import UsageError
 
 if TYPE_CHECKING:
@@ -58,13 +64,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "named call (call:NAME); repeatable, e.g. --time call:SprayOn=1.5",
     )
     add_check_options(parser)
+    from olp.commands.build import add_program_options
+
+    add_program_options(parser)
     parser.add_argument(
         "-q", "--quiet", action="store_true", help="results only: no table, progress or warnings"
     )
 
 
 def run(args: argparse.Namespace) -> int:
-    from olp.api import load_station, parse
+    from olp.api import load_station
     from olp.passes.resolve import resolve
     from olp.passes.timing import time_program
 
@@ -79,7 +88,7 @@ def run(args: argparse.Namespace) -> int:
 
         require_matplotlib()
     station = load_station(args.station)
-    parsed = parse(args.program)
+    parsed = parse_program(args, station)
     compiled = resolve(parsed.program, station, resolve_options(args))
     if compiled.ok:
         compiled = time_program(compiled, other_times)

@@ -1,0 +1,344 @@
+"""Python DSL frontend: run a ``.py`` robot program and record what it asks the robot to do.
+
+The program is ordinary Python executed with the names of :mod:`olp.dsl` already defined
+(``robot``, ``transl``, ``Pose``, ``param``...). **It runs with full Python privileges**, like
+any script: only run programs you trust. Each call on ``robot`` records one IR instruction
+whose span is the user's call (file, line and column of the innermost frame in the program
+file), so every later diagnostic points at the user's line.
+
+Parameters come from the command line (``--set SPEED=50``) and are read with
+``param("SPEED", default)``: text is converted to the type of the default (bool, int, float or
+text; without a default an int, else a float, else the text). A ``--set`` name the program
+never asks for is a :class:`~olp.errors.UsageError` (a typo must not pass silently).
+
+Errors: a syntax error, a wrong DSL call or any exception raised by the program becomes a
+:class:`~olp.errors.ParseError` at the user's line (the innermost traceback frame in the
+program file) with the line's text and a caret under the failing expression, never a
+traceback dump. ``sys.exit()`` / ``SystemExit(0)`` ends the program normally.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+from collections.abc import Mapping
+from dataclasses import dataclass
+from importlib.util import decode_source
+from pathlib import Path
+from types import CodeType, FrameType, TracebackType
+from typing import TYPE_CHECKING, Any
+
+from olp import dsl, ir
+from olp.errors import OlpError, ParseError, UsageError
+
+if TYPE_CHECKING:
+    from olp.station.model import Station
+
+
+@dataclass(frozen=True, slots=True)
+class IgnoredLine:
+    """A call olp recognised but did not lower (e.g. a linear acceleration): where and why."""
+
+    span: ir.SourceSpan
+    text: str
+    reason: str
+
+
+@dataclass(frozen=True, slots=True)
+class ProgramWarning:
+    """A warning the program reported with :func:`olp.dsl.warn` (e.g. a skipped target)."""
+
+    span: ir.SourceSpan
+    message: str
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class DslResult:
+    """What a DSL run recorded: the program, ignored settings, the program's own warnings and
+    the parameters it declared."""
+
+    program: ir.Program
+    ignored: tuple[IgnoredLine, ...] = ()
+    warnings: tuple[ProgramWarning, ...] = ()
+    params: tuple[str, ...] = ()
+
+
+def load_dsl(
+    path: str | os.PathLike[str],
+    station: Station | None = None,
+    params: Mapping[str, object] | None = None,
+) -> DslResult:
+    """Run the DSL program at ``path`` and return what it recorded.
+
+    Parameters
+    ----------
+    path : a ``.py`` file (any encoding Python accepts: UTF-8 or a PEP 263 cookie).
+    station : the station the program asks (home, named tools and frames, joint limits,
+        feasibility tests); without it those calls raise a located ParseError.
+    params : ``--set`` values by name (text from the command line, or Python values).
+    """
+    filename = os.fspath(path)
+    try:
+        data = Path(path).read_bytes()
+    except OSError as exc:
+        raise UsageError(f"cannot read program {filename!r}: {exc.strerror}") from None
+    return run_dsl(data, filename, station, params)
+
+
+def run_dsl(
+    source: bytes | str,
+    filename: str = "<string>",
+    station: Station | None = None,
+    params: Mapping[str, object] | None = None,
+) -> DslResult:
+    """Run DSL program text (see :func:`load_dsl`); ``filename`` names it in spans."""
+    text = _decode(source, filename)
+    code = _compile(text, filename)
+    session = Session(filename, text, station, params)
+    with dsl.active(session):
+        _execute(code, session)
+    unused = session.unused_params()
+    if unused:
+        declared = ", ".join(session.declared) or "none"
+        raise UsageError(
+            f"--set {', '.join(unused)}: the program has no such parameter (it reads: {declared})"
+        )
+    return session.result()
+
+
+# ------------------------------------------------------------------------------------------------
+# Reading and compiling
+
+
+def _decode(source: bytes | str, filename: str) -> str:
+    if isinstance(source, str):
+        return source
+    try:
+        return decode_source(source)
+    except SyntaxError as exc:
+        raise ParseError(
+            f"cannot read the file: {exc.msg}", ir.SourceSpan(filename, 1, 1)
+        ) from None
+    except UnicodeDecodeError as exc:
+        line = source.count(b"\n", 0, exc.start) + 1
+        raise ParseError(
+            f"the file is not valid UTF-8 (byte {source[exc.start]:#04x})",
+            ir.SourceSpan(filename, line, 1),
+            hint="save it as UTF-8 or declare its encoding (# -*- coding: ... -*-)",
+        ) from None
+
+
+def _compile(text: str, filename: str) -> CodeType:
+    try:
+        return compile(text, filename, "exec", dont_inherit=True)
+    except SyntaxError as exc:
+        raise _syntax_error(exc, text, filename) from None
+    except (ValueError, MemoryError, RecursionError) as exc:
+        raise ParseError(
+            f"cannot compile the program: {exc}", ir.SourceSpan(filename, 1, 1)
+        ) from None
+
+
+def _syntax_error(exc: SyntaxError, text: str, filename: str) -> ParseError:
+    lines = text.split("\n")
+    line = exc.lineno if exc.lineno and 1 <= exc.lineno <= len(lines) else len(lines)
+    column = max(exc.offset or 1, 1)
+    end = exc.end_offset if exc.end_lineno == line and exc.end_offset else None
+    span = ir.SourceSpan(filename, line, column, line if end else None, end)
+    return ParseError(f"Python syntax error: {exc.msg}", span, lines[line - 1] if lines else None)
+
+
+# ------------------------------------------------------------------------------------------------
+# Running
+
+
+def _execute(code: CodeType, session: Session) -> None:
+    try:
+        exec(code, session.namespace())
+    except SystemExit as exc:
+        if exc.code not in (None, 0):
+            raise _located(exc, session, f"the program exited with {exc.code!r}") from exc
+    except (OlpError, KeyboardInterrupt):
+        raise
+    except BaseException as exc:
+        raise _located(exc, session, _message(exc)) from exc
+
+
+def _message(exc: BaseException) -> str:
+    try:
+        text = str(exc)
+    except Exception:
+        text = "(its message cannot be shown)"
+    if isinstance(exc, dsl.DslError):
+        return text
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+
+
+def _located(exc: BaseException, session: Session, message: str) -> ParseError:
+    """A ParseError at the innermost frame of the program file in ``exc``'s traceback."""
+    frame = _innermost(exc.__traceback__, session.filename)
+    if frame is None:
+        span = ir.SourceSpan(session.filename, 1, 1)
+    else:
+        span = session.position(frame.tb_frame.f_code, frame.tb_lasti, frame.tb_lineno)
+    hint = None if isinstance(exc, dsl.DslError) else "raised while running the program"
+    return ParseError(message, span, session.line_text(span.line), hint)
+
+
+def _innermost(tb: TracebackType | None, filename: str) -> TracebackType | None:
+    found = None
+    while tb is not None:
+        if tb.tb_frame.f_code.co_filename == filename:
+            found = tb
+        tb = tb.tb_next
+    return found
+
+
+# ------------------------------------------------------------------------------------------------
+# The session a program talks to
+
+
+class Session:
+    """One run of a DSL program: its source, the station, the parameters and the recording."""
+
+    def __init__(
+        self,
+        filename: str,
+        text: str,
+        station: Station | None = None,
+        params: Mapping[str, object] | None = None,
+    ) -> None:
+        self.filename = filename
+        self.lines = text.split("\n")
+        self.station = station
+        self.params = dict(params or {})
+        self.declared: list[str] = []
+        self.name = Path(filename).stem
+        self.instructions: list[ir.Instruction] = []
+        self.ignored: list[IgnoredLine] = []
+        self.warnings: list[ProgramWarning] = []
+        self.targets: dict[str, dsl.Target] = {}
+        self.robot = dsl.Robot(self)
+        self._positions: dict[CodeType, list[tuple[Any, ...]]] = {}
+
+    def namespace(self) -> dict[str, Any]:
+        """The globals a program runs with: the public names of :mod:`olp.dsl`, and ``robot``
+        bound to this run."""
+        names = {name: getattr(dsl, name) for name in dsl.__all__}
+        names["robot"] = self.robot
+        return {
+            "__name__": "__main__",
+            "__file__": self.filename,
+            "__builtins__": __builtins__,
+            **names,
+        }
+
+    def result(self) -> DslResult:
+        program = ir.Program(
+            name=self.name, instructions=tuple(self.instructions), source=self.filename
+        )
+        return DslResult(
+            program=program,
+            ignored=tuple(self.ignored),
+            warnings=tuple(self.warnings),
+            params=tuple(self.declared),
+        )
+
+    # ---- spans
+    def span(self) -> ir.SourceSpan:
+        """Where the user's code called the DSL: the innermost frame of the program file."""
+        frame: FrameType | None = sys._getframe(1)
+        while frame is not None and frame.f_code.co_filename != self.filename:
+            frame = frame.f_back
+        if frame is None:
+            return ir.SourceSpan(self.filename, 1, 1)
+        return self.position(frame.f_code, frame.f_lasti, frame.f_lineno)
+
+    def position(self, code: CodeType, lasti: int, lineno: int | None) -> ir.SourceSpan:
+        """The span (1-based characters) of the bytecode instruction at ``lasti`` of ``code``:
+        the whole call expression, from Python's position table (Python >= 3.11)."""
+        positions = self._positions.get(code)
+        if positions is None and hasattr(code, "co_positions"):
+            positions = self._positions[code] = list(code.co_positions())
+        index = lasti // 2
+        entry = positions[index] if positions and 0 <= index < len(positions) else ()
+        line, end_line, col, end_col = (*entry, None, None, None, None)[:4]
+        line = line or lineno or 1
+        if col is None:
+            return ir.SourceSpan(self.filename, line, 1)
+        start = self._chars(line, col) + 1
+        if end_line != line or end_col is None:
+            return ir.SourceSpan(self.filename, line, start)
+        return ir.SourceSpan(self.filename, line, start, line, self._chars(line, end_col) + 1)
+
+    def _chars(self, line: int, byte_offset: int) -> int:
+        # The position table counts UTF-8 bytes; spans count characters.
+        text = self.line_text(line) or ""
+        return len(text.encode("utf-8")[:byte_offset].decode("utf-8", errors="ignore"))
+
+    def line_text(self, line: int) -> str | None:
+        return self.lines[line - 1] if 1 <= line <= len(self.lines) else None
+
+    # ---- recording
+    def record(self, instruction: ir.Instruction) -> None:
+        self.instructions.append(instruction)
+
+    def ignore(self, reason: str) -> None:
+        span = self.span()
+        self.ignored.append(IgnoredLine(span, (self.line_text(span.line) or "").strip(), reason))
+
+    def warn(self, message: str) -> None:
+        self.warnings.append(ProgramWarning(self.span(), message))
+
+    # ---- parameters
+    def param(self, name: str, default: object = None) -> Any:
+        if not isinstance(name, str) or not name.isidentifier():
+            raise dsl.DslError(f"param: the name must be an identifier like 'SPEED', got {name!r}")
+        if name not in self.declared:
+            self.declared.append(name)
+        if name in self.params:
+            return convert_param(name, self.params[name], default)
+        if default is None:
+            raise dsl.DslError(f"parameter {name} has no default: give it with --set {name}=VALUE")
+        return default
+
+    def unused_params(self) -> list[str]:
+        return [name for name in self.params if name not in self.declared]
+
+
+def convert_param(name: str, raw: object, default: object) -> Any:
+    """A ``--set`` value as the type of the parameter's default.
+
+    Text (from the command line) becomes a bool (``true/false/yes/no/on/off/1/0``), an int, a
+    float (finite) or stays text, following the default; without a default an int, else a
+    float, else the text. Python values (library callers) are taken as they are.
+    """
+    if not isinstance(raw, str):
+        return raw
+    if isinstance(default, bool):
+        word = raw.strip().lower()
+        if word not in dsl.TRUE_WORDS | dsl.FALSE_WORDS:
+            raise dsl.DslError(f"--set {name}={raw}: expected true or false (default {default})")
+        return word in dsl.TRUE_WORDS
+    if isinstance(default, str):
+        return raw
+    value = _guess(raw)
+    if isinstance(default, int) and not isinstance(value, int):
+        raise dsl.DslError(f"--set {name}={raw}: expected an integer (default {default})")
+    if isinstance(default, float):
+        if not isinstance(value, int | float) or not math.isfinite(value):
+            raise dsl.DslError(f"--set {name}={raw}: expected a finite number (default {default})")
+        return float(value)
+    return value
+
+
+def _guess(text: str) -> object:
+    """Command-line text as an int, else a float, else the text itself."""
+    stripped = text.strip()
+    for kind in (int, float):
+        try:
+            return kind(stripped)
+        except ValueError:
+            continue
+    return text
