@@ -28,6 +28,7 @@ from olp.ir import (
     MOTION_TYPES,
     CartesianTarget,
     CircularMove,
+    Configuration,
     Frame,
     Instruction,
     JointMove,
@@ -440,6 +441,10 @@ def _joint_path(
     candidates = _candidates(robot, flange)
     if candidates.shape[0] == 0:
         return None, [_unreachable(index, ins, robot, flange)]
+    if ins.target.config is not None:
+        candidates, found = _configured(index, ins, robot, candidates, ins.target.config)
+        if candidates.shape[0] == 0:
+            return None, found
     return _joint_line(state.q, _nearest(candidates, state.q, state.opts.weights)), []
 
 
@@ -459,6 +464,41 @@ def _nearest(candidates: FloatArray, q: FloatArray, weights: tuple[float, ...]) 
     cost = np.sum(np.asarray(weights) * (candidates - q) ** 2, axis=-1)
     best: FloatArray = candidates[np.argmin(cost)]
     return best
+
+
+def _configured(
+    index: int, ins: JointMove, robot: Robot, candidates: FloatArray, config: Configuration
+) -> tuple[FloatArray, list[Diagnostic]]:
+    """The candidates (K, 6) that meet the configuration the source asks for (KUKA S/T, ABB
+    confdata, Fanuc CONFIG): a joint move must take exactly that solution, as the controller
+    would. Linear moves keep the branch they start in (controllers ignore S/T there)."""
+    from olp.kinematics.configuration import satisfies
+
+    try:
+        chosen = candidates[satisfies(config, candidates, robot)]
+    except TypeError:  # not an OPW arm: the request cannot be read, say so
+        msg = "the target's configuration cannot be checked on this robot; nearest solution used"
+        return candidates, [Diagnostic("warning", "configuration_ignored", msg, ins.span, index)]
+    if chosen.shape[0] == 0:
+        msg = (
+            "the target is reachable, but not in the configuration the program asks for "
+            f"({_describe(config)}) within the joint limits"
+        )
+        hint = "re-teach the point, or drop its Status/Turn so olp picks the nearest solution"
+        return chosen, [_error("configuration", msg, index, ins, hint=hint)]
+    return chosen, []
+
+
+def _describe(config: Configuration) -> str:
+    parts = [v for v in (config.shoulder, config.elbow, config.wrist) if v is not None]
+    if config.joint_ranges is not None:
+        ranges = [
+            f"axis {i + 1} in [{np.degrees(r[0]):.0f}°, {np.degrees(r[1]):.0f}°)"
+            for i, r in enumerate(config.joint_ranges)
+            if r is not None and np.all(np.isfinite(r))
+        ]
+        parts.extend(ranges)
+    return ", ".join(parts) or "no constraint"
 
 
 def _candidates(robot: Robot, flange: FloatArray) -> FloatArray:

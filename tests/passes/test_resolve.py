@@ -239,3 +239,43 @@ def test_speed_warning_names_the_axis_that_cannot_keep_up(station: Station) -> N
     assert len(found) == 1  # consecutive moves are reported together
     assert found[0].severity == "warning" and "moves 1-39" in found[0].message
     assert "the TCP will be slower" in found[0].message
+
+
+def _config_of(station: Station, deg: list[float]) -> ir.Configuration:
+    from olp.kinematics.configuration import configuration_of
+
+    return configuration_of(station.robot, np.radians(deg))
+
+
+def test_ptp_takes_the_solution_its_configuration_asks_for(station: Station) -> None:
+    from olp.passes.resolve import _candidates
+
+    robot = station.robot
+    near = np.radians([0, -90, 90, 0, 30, 0])
+    pose = robot.flange_poses(np.radians([20, -100, 110, 30, 40, 10]))
+    candidates = _candidates(robot, pose)
+    nearest = candidates[np.argmin(np.sum((candidates - near) ** 2, axis=-1))]
+    # another in-limits solution in a different branch than the nearest one
+    other = next(c for c in candidates if robot.branch_of(c) != robot.branch_of(nearest))
+    plain = ir.JointMove(target=ir.CartesianTarget(pose=pose), span=_span(2))
+    asked = ir.JointMove(
+        target=ir.CartesianTarget(pose=pose, config=_config_of(station, list(np.degrees(other)))),
+        span=_span(2),
+    )
+    start = ir.JointMove(target=ir.JointTarget(joints=near))
+    got_plain = resolve(ir.Program(name="t", instructions=[start, plain]), station).steps[1]
+    got_asked = resolve(ir.Program(name="t", instructions=[start, asked]), station).steps[1]
+    assert got_plain.joints is not None and np.allclose(got_plain.joints, nearest, atol=1e-9)
+    assert got_asked.joints is not None and np.allclose(got_asked.joints, other, atol=1e-9)
+
+
+def test_configuration_outside_the_limits_is_an_error_on_its_line(station: Station) -> None:
+    wanted = [20, -100, 110, 30, 40, 10]
+    pose = station.robot.flange_poses(np.radians(wanted))
+    impossible = ir.Configuration(
+        shoulder="front", elbow="up", wrist="noflip",
+        joint_ranges=(None, None, None, None, None, (np.radians(400), np.radians(500))),
+    )  # fmt: skip
+    move = ir.JointMove(target=ir.CartesianTarget(pose=pose, config=impossible), span=_span(9))
+    found = _run(station, _ptp([0, -90, 90, 0, 30, 0]), move)
+    assert found == [("configuration", 9)]
