@@ -490,7 +490,7 @@ def _configured(
 
 
 def _describe(config: Configuration) -> str:
-    parts = [v for v in (config.shoulder, config.elbow, config.wrist) if v is not None]
+    parts: list[str] = [v for v in (config.shoulder, config.elbow, config.wrist) if v is not None]
     if config.joint_ranges is not None:
         ranges = [
             f"axis {i + 1} in [{np.degrees(r[0]):.0f}°, {np.degrees(r[1]):.0f}°)"
