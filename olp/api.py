@@ -42,12 +42,14 @@ def parse(
     station: Station | None = None,
     params: Mapping[str, object] | None = None,
     csv_options: CsvOptions | None = None,
+    krl_config_dat: str | Path | None = None,
 ) -> ParsedProgram:
     """Read a program file; the frontend is chosen by suffix (see :data:`FRONTENDS`).
 
     ``station``: what CSV and Python programs may consult (tools and frames by name, the home
     position, feasibility questions); ``params``: ``--set`` values for a Python program;
-    ``csv_options``: how to read a CSV toolpath. Options a frontend does not take are a
+    ``csv_options``: how to read a CSV toolpath; ``krl_config_dat``: the controller's
+    ``$config.dat`` for TOOL_DATA/BASE_DATA/HOME values. Options a frontend does not take are a
     :class:`UsageError` rather than silently unused.
     """
     path = Path(path)
@@ -60,7 +62,10 @@ def parse(
         raise UsageError(f"--set parameters are for Python programs, not {suffix} files")
     if csv_options is not None and suffix != ".csv":
         raise UsageError(f"CSV options are for .csv toolpaths, not {suffix} files")
-    return frontend(path, _ParseContext(station, params or {}, csv_options))
+    if krl_config_dat is not None and suffix != ".src":
+        raise UsageError(f"--config-dat is for KRL .src programs, not {suffix} files")
+    context = _ParseContext(station, params or {}, csv_options, krl_config_dat)
+    return frontend(path, context)
 
 
 @dataclass(frozen=True, slots=True)
@@ -68,13 +73,17 @@ class _ParseContext:
     station: Station | None
     params: Mapping[str, object]
     csv_options: CsvOptions | None
+    krl_config_dat: str | Path | None = None
 
 
-def _parse_krl(path: Path, _context: _ParseContext) -> ParsedProgram:
+def _parse_krl(path: Path, context: _ParseContext) -> ParsedProgram:
     from olp.frontends.krl import load_krl
 
-    result = load_krl(path)
-    return ParsedProgram(result.program, _ignored_notes(result.ignored))
+    result = load_krl(path, config_dat=context.krl_config_dat)
+    remarks = tuple(
+        Diagnostic("warning", "krl_note", note.message, note.span) for note in result.notes
+    )
+    return ParsedProgram(result.program, _ignored_notes(result.ignored) + remarks)
 
 
 def _parse_csv(path: Path, context: _ParseContext) -> ParsedProgram:
@@ -155,6 +164,7 @@ def build(
     options: ResolveOptions | None = None,
     params: Mapping[str, object] | None = None,
     csv_options: CsvOptions | None = None,
+    krl_config_dat: str | Path | None = None,
 ) -> BuildResult:
     """Compile ``program`` on ``station`` and render it through ``post``.
 
@@ -168,7 +178,13 @@ def build(
         station = load_station(station)
     notes: tuple[Diagnostic, ...] = ()
     if not isinstance(program, Program):
-        parsed = parse(program, station=station, params=params, csv_options=csv_options)
+        parsed = parse(
+            program,
+            station=station,
+            params=params,
+            csv_options=csv_options,
+            krl_config_dat=krl_config_dat,
+        )
         program, notes = parsed.program, parsed.notes
     manifest = find_post(post)
     compiled = compile(program, station, options)

@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 from olp.commands.check import add_check_options, resolve_options
@@ -40,6 +39,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("-o", "--out", default="out", help="output folder (default: out)")
     parser.add_argument("--name", help="program name in the output (default: from the source)")
     parser.add_argument("--report", help="write a JSON report to this file")
+    parser.add_argument("--sarif", help="write the diagnostics as SARIF 2.1.0 to this file")
     parser.add_argument("-q", "--quiet", action="store_true", help="print errors only")
     add_check_options(parser)
     add_program_options(parser)
@@ -53,6 +53,11 @@ def add_program_options(parser: argparse.ArgumentParser) -> None:
         default=[],
         metavar="NAME=VALUE",
         help="a parameter of a Python program (repeatable), read with param('NAME', default)",
+    )
+    parser.add_argument(
+        "--config-dat",
+        metavar="PATH",
+        help="KRL programs: the controller's $config.dat (TOOL_DATA, BASE_DATA, HOME values)",
     )
     csv = parser.add_argument_group("CSV toolpaths")
     csv.add_argument("--tool", help="station tool the rows are for (default: its first tool)")
@@ -125,7 +130,8 @@ def _orientation(text: str) -> tuple[float, float, float] | None:
 
 def run(args: argparse.Namespace) -> int:
     from olp.api import build
-    from olp.report import report_json, summary
+    from olp.commands.check import write_outputs
+    from olp.report import summary
 
     require_files(args.station, args.program)
     result = build(
@@ -137,13 +143,10 @@ def run(args: argparse.Namespace) -> int:
         options=resolve_options(args),
         params=program_params(args),
         csv_options=csv_options(args),
+        krl_config_dat=args.config_dat,
     )
     print_diagnostics(result.diagnostics, args.program, quiet=args.quiet)
-    if args.report:
-        from olp.post import write_files
-
-        report = Path(args.report)
-        write_files({report.name: report_json(result)}, report.parent, "utf-8")
+    write_outputs(args, result)
     if not args.quiet:
         print(summary(result), file=sys.stdout)
     return EXIT_OK if result.ok else EXIT_PROGRAM_ERRORS

@@ -52,5 +52,9 @@ def parse_program(args: argparse.Namespace, station: Station) -> ParsedProgram:
     from olp.commands.build import csv_options, program_params
 
     return parse(
-        args.program, station=station, params=program_params(args), csv_options=csv_options(args)
+        args.program,
+        station=station,
+        params=program_params(args),
+        csv_options=csv_options(args),
+        krl_config_dat=args.config_dat,
     )

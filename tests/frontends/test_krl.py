@@ -138,10 +138,19 @@ def test_headers_folds_comments_whitespace_and_crlf(milling: KrlResult) -> None:
 
 def test_names_that_start_with_keywords_are_names() -> None:
     result = parse(
-        "LINE = 1", "PTPX = 2", "endless = 3", "FOR i = 1 TO TOTAL", "ENDFOR", "LIN_ON()"
+        "LINE = 1",
+        "PTPX = 2",
+        "endless = 3",
+        "FOR i = 1 TO TOTAL",
+        "ENDFOR",
+        "LIN_ON()",
+        "WAIT SEC LINE + PTPX + endless",
     )
-    assert [i.span.line for i in result.ignored] == [2, 3, 4, 5]
-    assert [without_span(i) for i in result.program] == [ir.Call(name="LIN_ON")]
+    assert [i.span.line for i in result.ignored] == [5]  # constant assignments are evaluated
+    assert [without_span(i) for i in result.program] == [
+        ir.Call(name="LIN_ON"),
+        ir.Wait(seconds=6.0),
+    ]
 
 
 @pytest.mark.parametrize(
@@ -386,7 +395,7 @@ def test_other_routines_are_listed() -> None:
         ("WAIT SEC -1", 10, ">= 0"),
         ("LIN {X 1e999,Y 2,Z 3,A 0,B 0,C 0}", 8, "out of range"),
         ("GOTO somewhere", 1, "GOTO"),
-        ("SLIN {X 1}", 1, "SLIN"),
+        ("SPL {X 1}", 1, "SPL"),
         ("BAS(#PTP_PARAMS, 100)", 1, "PTP_PARAMS"),
     ],
 )
@@ -488,7 +497,8 @@ def test_fuzz_mutated_programs(data: st.DataObject) -> None:
 
 
 def test_nesting_too_deep_is_a_parse_error() -> None:
-    assert parse("x = " + "(" * 3000 + "1" + ")" * 3000).ignored  # parentheses add no depth
+    deep = parse("x = " + "(" * 3000 + "1" + ")" * 3000, "WAIT SEC x")  # parentheses add no depth
+    assert [without_span(i) for i in deep.program] == [ir.Wait(seconds=1.0)]
     error = parse_error("x = " + "-" * 3000 + "1")
     assert error.span is not None and error.span.line == 1
     assert "nested too deeply" in error.message

@@ -1,0 +1,267 @@
+"""KRL data lists (``DEFDAT ... ENDDAT``): a module's ``.dat`` and the controller's ``$config.dat``.
+
+A data list declares variables with values: the points the pendant taught
+(``DECL E6POS XP1={X ..,S 6,T 27,...}``), the inline forms' motion data (``DECL PDAT PPDAT1``,
+``LDAT``, ``FDAT``), and in ``$config.dat`` the tool and base tables (``TOOL_DATA[1]={X ..}``,
+``TOOL_NAME[1,]="Gripper"``), ``XHOME``, ``FHOME``, ``PDEFAULT`` and signal names. olp reads
+declarations, value assignments and one-bit ``SIGNAL`` names; other statements a data list may
+hold (``EXT``, ``STRUC``, ``ENUM``, ...) are listed as ignored with the reason. Anything that
+does not belong in a data list (motions, calls, control flow) is an error.
+
+:class:`DataOps` does declarations and assignments of program variables for both data lists and
+routines, so both follow the same rules.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+
+from olp import ir
+from olp.errors import ParseError
+from olp.frontends.krl_ast import (
+    Assign,
+    DatBlock,
+    Decl,
+    IgnoredLine,
+    Index,
+    Module,
+    Other,
+    SignalDecl,
+    Source,
+    SourceSet,
+    Stmt,
+    Text,
+    Var,
+)
+from olp.frontends.krl_parse import gc_paused, parse_module
+from olp.frontends.krl_values import (
+    NOT_SET,
+    ArrayValue,
+    ElementKey,
+    Evaluator,
+    Signal,
+    Unknown,
+    Value,
+    Variables,
+    assign_path,
+    with_type,
+)
+
+OTHER_REASONS = {
+    "EXT": "external declarations are not needed by olp",
+    "STRUC": "type definitions are not needed: olp reads values by their member names",
+    "ENUM": "type definitions are not needed: olp reads enumeration values by name",
+    "INTERRUPT DECL": "interrupts are not lowered (the IR has no event handlers)",
+    "INTERRUPT": "interrupts are not lowered (the IR has no event handlers)",
+    "TRIGGER": "path-related switching actions (TRIGGER) are not lowered yet",
+    "label": "jump labels are not lowered (GOTO is not supported)",
+    "HALT": "HALT (stop until restarted) has no IR equivalent",
+    "EXIT": "EXIT only matters inside a loop",
+    "CONTINUE": "CONTINUE only affects the controller's advance run",
+    "BRAKE": "BRAKE only matters in interrupt routines",
+}
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class KrlData:
+    """What olp read from one data list: its name, variables and the lines it ignored.
+
+    Read one with :func:`olp.frontends.krl.load_config_dat` (or :func:`read_data_list`) and pass
+    it to :func:`olp.frontends.krl.load_krl` for as many programs as need it.
+    """
+
+    name: str
+    filename: str
+    values: Mapping[str, Value]
+    ignored: tuple[IgnoredLine, ...]
+    source: Source
+
+    def names(self) -> tuple[str, ...]:
+        """The declared names (upper case), in the order they were read."""
+        return tuple(self.values)
+
+
+class DataOps:
+    """Declarations, assignments and SIGNALs of program variables (for .dat files and routines).
+
+    Methods return None when the statement was read, else the reason it was not (the caller
+    lists the statement as ignored).
+    """
+
+    def __init__(self, variables: Variables, evaluator: Evaluator, sources: SourceSet) -> None:
+        self.variables = variables
+        self.evaluator = evaluator
+        self.sources = sources
+
+    def declare(self, decl: Decl, into: Callable[[str, Value], None]) -> str | None:
+        """Each item gets its value (or :class:`Unknown` when it has none)."""
+        missing = []
+        for item in decl.items:
+            name = item.name.upper()
+            if item.dims is not None and item.value is None:
+                into(name, ArrayValue(decl.type_name, {}, item.span))
+                continue
+            if item.value is None:
+                if not self.variables.is_param(name):
+                    missing.append(item.name)
+                where = f"{item.span.location}"
+                into(name, Unknown(f"{item.name} is declared at {where} without a value"))
+                continue
+            value = self.evaluator.evaluate(item.value)
+            into(name, value if isinstance(value, Unknown) else with_type(value, decl.type_name))
+        if missing:
+            return (
+                f"declares {', '.join(missing)} without a value (olp knows a value only once "
+                "the program assigns a constant)"
+            )
+        return None
+
+    def assign(self, stmt: Assign) -> str | None:
+        """``name[...].field = value`` with a constant value; else the variable becomes unknown."""
+        target = stmt.target
+        name = target.name.upper()
+        value = self.evaluator.evaluate(stmt.value)
+        keys = self._keys(target)
+        for unknown in (value, keys):
+            if isinstance(unknown, Unknown):
+                self._forget(name, stmt, unknown)
+                return f"the value is not constant: {unknown.reason}"
+        assert not isinstance(value, Unknown) and not isinstance(keys, Unknown)
+        old = self.variables.lookup(name) if self.variables.is_declared(name) else NOT_SET
+        new = assign_path(old, target.selectors, value, keys, stmt.span)
+        if isinstance(new, Unknown) and target.selectors:
+            self._forget(name, stmt, new)
+            return f"{new.reason}; {target.name} is unknown from here on"
+        self.variables.assign(name, new)
+        return None
+
+    def _keys(self, target: Var) -> list[ElementKey] | Unknown:
+        keys: list[ElementKey] = []
+        for selector in target.selectors:
+            if isinstance(selector, Index):
+                key = self.evaluator.index_key(selector)
+                if isinstance(key, Unknown):
+                    return key
+                keys.append(key)
+        return keys
+
+    def _forget(self, name: str, stmt: Assign, why: Unknown) -> None:
+        """``name`` is unknown from here on; the reason says where and why (with its hint)."""
+        value = self.sources.snippet(stmt.value.span)
+        message = f"{stmt.target.name} was assigned {value!r} at {stmt.span.location}"
+        self.variables.assign(name, Unknown(f"{message}, and {why.reason}", why.hint))
+
+    def signal(self, stmt: SignalDecl, into: Callable[[str, Value], None]) -> str | None:
+        """``SIGNAL name $OUT[n]``: the name stands for that one bit from here on."""
+        first = stmt.first
+        if stmt.last is not None or not (isinstance(first, Var) and first.key in _IO_KEYS):
+            into(stmt.name, Unknown(f"SIGNAL {stmt.name} is not a single $IN/$OUT bit"))
+            return "only one-bit SIGNALs of $IN[n] / $OUT[n] are read"
+        key = self._keys(first)
+        index = None if isinstance(key, Unknown) else as_int_key(key)
+        if index is None:
+            into(stmt.name, Unknown(f"SIGNAL {stmt.name} has no constant index"))
+            return "the SIGNAL's index is not a constant"
+        into(stmt.name, Signal(first.name.upper(), index, stmt.span))
+        return None
+
+
+_IO_KEYS = frozenset({"$IN[]", "$OUT[]"})
+
+
+def as_int_key(keys: list[ElementKey]) -> int | None:
+    """The index of ``$OUT[n]`` from its evaluated keys."""
+    if len(keys) == 1 and len(keys[0]) == 1 and isinstance(keys[0][0], int):
+        return keys[0][0]
+    return None
+
+
+# ------------------------------------------------------------------------------------------------
+# Reading a data list
+
+
+def read_data_list(text: str, filename: str) -> KrlData:
+    """Read the one ``DEFDAT ... ENDDAT`` of ``text``; :class:`ParseError` if it is not one."""
+    source = Source.of(text, filename)
+    with gc_paused():
+        module = parse_module(source, fast=False)
+    block = _the_data_block(module, source)
+    return _read_block(block, source)
+
+
+def _the_data_block(module: Module, source: Source) -> DatBlock:
+    blocks = [item for item in module.items if isinstance(item, DatBlock)]
+    for item in module.items:
+        if not isinstance(item, DatBlock):
+            name = os.path.basename(source.filename)
+            message = f"{item.kind} {item.name} in a data list: {name} must hold DEFDAT ... ENDDAT"
+            raise source.error(message, item.span)
+    if len(blocks) != 1:
+        line, column = source.last_position() if not blocks else (blocks[1].span.line, 1)
+        span = ir.SourceSpan(source.filename, line, column)
+        raise source.error("a data list holds exactly one DEFDAT ... ENDDAT", span)
+    return blocks[0]
+
+
+def _read_block(block: DatBlock, source: Source) -> KrlData:
+    sources = SourceSet([source])
+    base = os.path.basename(source.filename)
+
+    def missing(name: str) -> Unknown:
+        return Unknown(f"{name} is not declared in {base} before this line")
+
+    values: dict[str, Value] = {}
+    variables = Variables(values, missing)
+    ops = DataOps(variables, Evaluator(variables, sources.snippet), sources)
+    ignored: list[IgnoredLine] = []
+
+    def store(name: str, value: Value) -> None:
+        values[name] = value
+
+    for stmt in block.body:
+        reason = _read_statement(stmt, ops, store, sources)
+        if reason is not None:
+            ignored.append(IgnoredLine(stmt.span, sources.snippet(stmt.span), reason))
+    return KrlData(
+        name=block.name,
+        filename=source.filename,
+        values=values,
+        ignored=tuple(ignored),
+        source=source,
+    )
+
+
+def _read_statement(
+    stmt: Stmt, ops: DataOps, store: Callable[[str, Value], None], sources: SourceSet
+) -> str | None:
+    if isinstance(stmt, Decl):
+        return ops.declare(stmt, store)
+    if isinstance(stmt, Assign):
+        return ops.assign(stmt)
+    if isinstance(stmt, SignalDecl):
+        return ops.signal(stmt, store)
+    if isinstance(stmt, Other) and stmt.kind in _DATA_LIST_OTHERS:
+        return OTHER_REASONS[stmt.kind]
+    raise _not_data(stmt, sources)
+
+
+_DATA_LIST_OTHERS = frozenset({"EXT", "STRUC", "ENUM"})
+"""Statements a data list may hold that olp does not need."""
+
+
+def _not_data(stmt: Stmt, sources: SourceSet) -> ParseError:
+    found = sources.snippet(stmt.span)
+    return sources.error(
+        f"{found!r} does not belong in a data list",
+        stmt.span,
+        hint="a DEFDAT holds declarations (DECL ...), value assignments and SIGNALs",
+    )
+
+
+def text_value(value: Value) -> str | None:
+    """The string of a CHAR array row or string constant, without padding, if it has one."""
+    if isinstance(value, Text):
+        return value.value.strip() or None
+    return None

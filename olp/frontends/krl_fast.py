@@ -1,0 +1,97 @@
+"""Read the common simple motion lines of KRL without lark.
+
+Milling programs are 10k-100k lines like ``LIN {X 12.5,Y -3,Z 6.35,A 180,B 0,C -180} C_DIS``.
+lark spends most of its time on them, so :func:`scan_line` recognises exactly this shape with one
+regular expression and returns a :class:`~olp.frontends.krl_ast.FastMotion`; every other line
+(and any line this module is not sure about) goes through the full grammar.
+
+The accepted shape is a strict subset of what ``grammars/krl.lark`` accepts, chosen so that the
+result is the same as the grammar's, spans included (pinned by tests that compare both paths):
+
+* keyword ``PTP``, ``LIN``, ``SPTP`` or ``SLIN``, then one aggregate, then approximation keywords,
+  then an optional comment;
+* members named only ``X Y Z A B C S T A1..A6 E1..E6`` (none is a KRL keyword, so the lexer
+  cannot read them differently), an optional type ``E6POS POS FRAME AXIS E6AXIS``;
+* values that are plain signed numbers, each followed by ``,`` or ``}``.
+"""
+
+from __future__ import annotations
+
+import re
+
+from olp import ir
+from olp.frontends.krl_ast import Aggregate, FastMotion, Member, MotionStmt, Num
+
+# A character that continues a KRL name: where a keyword or member name must not be followed by one.
+_NAME_CHAR = r"[a-z0-9_$]"
+_WS = r"[ \t]*"
+# No blank after the sign (the grammar allows one): then float() reads the token as it stands.
+_NUMBER = r"[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:e[+-]?\d+)?"
+_MEMBER_NAME = rf"(?:[xyzabcst]|[ae][1-6])(?!{_NAME_CHAR})"
+_MEMBER = rf"{_WS}({_MEMBER_NAME}){_WS}({_NUMBER}){_WS}"
+_TYPE = rf"{_WS}(e6pos|pos|frame|axis|e6axis){_WS}:"
+_APPROX = rf"c_(?:ptp|dis|vel|ori)(?!{_NAME_CHAR})"
+_ANY_MEMBER = rf"{_WS}{_MEMBER_NAME}{_WS}{_NUMBER}{_WS}"
+_ANY_TYPE = rf"{_WS}(?:e6pos|pos|frame|axis|e6axis){_WS}:"
+
+# Groups: 1 keyword, 2 aggregate, 3 approximation keywords.
+_LINE = re.compile(
+    rf"{_WS}(sptp|slin|ptp|lin){_WS}"
+    rf"(\{{(?:{_ANY_TYPE})?(?:{_ANY_MEMBER},)*{_ANY_MEMBER}\}})"
+    rf"((?:{_WS}{_APPROX})*)"
+    rf"{_WS}(?:;.*)?\r?",
+    re.IGNORECASE,
+)
+_MEMBERS = re.compile(_MEMBER, re.IGNORECASE)
+_TYPE_PREFIX = re.compile(_TYPE, re.IGNORECASE)
+_APPROX_WORD = re.compile(_APPROX, re.IGNORECASE)
+
+
+def signed_number(token: str) -> tuple[float, bool]:
+    """The value of a ``SIGNED_NUMBER`` token (sign, blanks, digits) and whether it is an integer.
+
+    ``-0.000`` is ``-0.0``, as the grammar's path reads it too.
+    """
+    digits = "".join(token.split()).lstrip("+-")
+    value = float(digits)
+    return (-value if token.startswith("-") else value), digits.isdigit()
+
+
+def scan_line(line: str, number: int, filename: str) -> FastMotion | None:
+    """The simple motion on ``line`` (1-based line ``number``), or None for anything else."""
+    match = _LINE.fullmatch(line)
+    if match is None:
+        return None
+    aggregate = match.group(2)
+    prefix = _TYPE_PREFIX.match(aggregate, 1)
+    start = 1 if prefix is None else prefix.end()
+    names, values = zip(*_MEMBERS.findall(aggregate, start), strict=True)
+    approx = tuple(word.upper() for word in _APPROX_WORD.findall(match.group(3)))
+    end = match.end(3) if approx else match.end(2)
+    span = ir.SourceSpan(filename, number, match.start(1) + 1, number, end + 1)
+    type_name = None if prefix is None else prefix.group(1)
+    keyword = match.group(1).upper()
+    numbers = tuple(map(float, values))
+    return FastMotion(keyword, type_name, tuple(map(str.upper, names)), numbers, approx, span, line)
+
+
+def materialise(fast: FastMotion) -> MotionStmt:
+    """The full :class:`MotionStmt` of a fast line, with the spans the grammar would give."""
+    match = _LINE.fullmatch(fast.text)
+    assert match is not None, "a FastMotion always comes from a matching line"
+    file, number = fast.span.file, fast.span.line
+
+    def span(start: int, end: int) -> ir.SourceSpan:
+        return ir.SourceSpan(file, number, start + 1, number, end + 1)
+
+    agg_start = match.start(2)
+    prefix = _TYPE_PREFIX.match(fast.text, agg_start + 1)
+    position = agg_start + 1 if prefix is None else prefix.end()
+    members = []
+    for found in _MEMBERS.finditer(fast.text, position, match.end(2)):
+        value, is_int = signed_number(found.group(2))
+        num = Num(value, is_int, span(found.start(2), found.end(2)))
+        members.append(Member(found.group(1), num, span(found.start(1), found.end(2))))
+    type_name = None if prefix is None else prefix.group(1)
+    aggregate = Aggregate(type_name, tuple(members), span(agg_start, match.end(2)))
+    return MotionStmt(fast.keyword, (aggregate,), None, fast.approx, fast.span)

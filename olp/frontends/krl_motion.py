@@ -1,0 +1,416 @@
+"""KRL lowering of motions: PTP/LIN/CIRC, their spline and _REL forms, and the fast path.
+
+Targets are inline aggregates or named points; Cartesian ones stay KRL values (mm, deg) until
+:func:`olp.frontends.krl_state.build_instructions`. See :mod:`olp.frontends.krl` for the rules.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from olp import ir
+from olp.frontends.krl_ast import (
+    Aggregate,
+    Expr,
+    FastMotion,
+    MotionStmt,
+    StatusTurn,
+    Var,
+)
+from olp.frontends.krl_fast import materialise
+from olp.frontends.krl_inline import InlineForms
+from olp.frontends.krl_state import (
+    DEFAULT_VEL_CP,
+    Cartesian,
+    Pending,
+    Target,
+)
+from olp.frontends.krl_values import (
+    AXES,
+    CARTESIAN,
+    EXTERNAL,
+    is_axis_aggregate,
+)
+from olp.vendors.kuka import configuration_from_status_turn, frame_to_pose, pose_to_frame
+
+_BASE_MOTION = {
+    "PTP": "PTP",
+    "SPTP": "PTP",
+    "PTP_REL": "PTP",
+    "LIN": "LIN",
+    "SLIN": "LIN",
+    "LIN_REL": "LIN",
+    "CIRC": "CIRC",
+    "SCIRC": "CIRC",
+    "CIRC_REL": "CIRC",
+}
+_SPLINE_MOTIONS = frozenset({"SPTP", "SLIN", "SCIRC"})
+_CP_APPROX = ("C_DIS", "C_VEL", "C_ORI")
+_ONE_CP_APPROX = frozenset((a,) for a in _CP_APPROX)
+_FAST_KEYWORDS = {"PTP": "PTP", "SPTP": "PTP", "LIN": "LIN", "SLIN": "LIN"}
+_AXIS_SET = frozenset(AXES)
+_CARTESIAN_SET = frozenset(CARTESIAN)
+
+
+class Motions(InlineForms):
+    """Motion statements -> IR motions, tracking where the robot goes."""
+
+    # ---- the fast path
+    def _fast_motion(self, stmt: FastMotion) -> None:
+        """The common simple motion, lowered without building its full AST; anything less
+        common goes through :meth:`_motion` with the materialised statement."""
+        if not self._lower_fast(stmt):
+            self._motion(materialise(stmt))
+
+    def _lower_fast(self, stmt: FastMotion) -> bool:
+        base = _FAST_KEYWORDS[stmt.keyword]
+        state, track = self.state, self.track
+        if (
+            self._after_with is not None
+            or stmt.type_name is not None
+            or not all(map(math.isfinite, stmt.values))
+        ):
+            return False
+        zone = self._fast_zone(stmt.approx, base, stmt.keyword)
+        members = dict(zip(stmt.names, stmt.values, strict=True))
+        if zone is None or len(members) != len(stmt.names):
+            return False
+        target: Target
+        if base == "PTP" and members.keys() == _AXIS_SET:
+            degrees = tuple(members[a] for a in AXES)
+            track.at_axes(degrees, stmt.span.line)
+            target = ir.JointTarget(joints=np.radians(degrees))
+        elif members.keys() <= _CARTESIAN_SET and (base == "PTP" or state.vel_cp_set):
+            previous = track.cartesian
+            if len(members) == len(CARTESIAN):
+                values = tuple(members[c] for c in CARTESIAN)
+            elif previous is not None:
+                values = tuple(members.get(c, previous[i]) for i, c in enumerate(CARTESIAN))
+            else:
+                return False
+            track.at_position(values, stmt.span.line)
+            target = Cartesian(values)
+        else:
+            return False
+        make = ir.JointMove if base == "PTP" else ir.LinearMove
+        fields = {
+            "speed": state.speed,
+            "zone": zone,
+            "tool": state.tool,
+            "frame": state.frame,
+            "span": stmt.span,
+        }
+        self._emit(make, target, None, fields)
+        return True
+
+    def _fast_zone(self, approx: tuple[str, ...], base: str, keyword: str) -> ir.Zone | None:
+        if not approx:
+            return ir.FINE
+        cdis = self.state.cdis_mm
+        valid = ("C_PTP",) if base == "PTP" else ("C_DIS",)
+        if (
+            cdis is None
+            or approx not in (valid, (*valid, "C_DIS"))
+            or keyword not in ("PTP", "LIN")
+        ):
+            return None
+        return ir.Zone(cdis / 1000.0)
+
+    # ---- motions
+    def _motion(self, stmt: MotionStmt) -> None:
+        base = _BASE_MOTION.get(stmt.keyword)
+        if base is None:
+            raise self._error(
+                f"{stmt.keyword} is a spline segment: it belongs inside SPLINE ... ENDSPLINE",
+                stmt.span,
+            )
+        expected = 2 if base == "CIRC" else 1
+        if len(stmt.targets) != expected:
+            message = f"{stmt.keyword} takes {expected} target{'s' if expected > 1 else ''}"
+            raise self._error(f"{message}, found {len(stmt.targets)}", stmt.span)
+        if stmt.angle is not None:
+            raise self._error("CIRC with CA (circular angle) is not supported yet", stmt.angle.span)
+        relative = stmt.keyword.endswith("_REL")
+        if stmt.frame_option is not None and not relative:
+            raise self._error(
+                f"{stmt.keyword} takes no #BASE/#TOOL (only the _REL motions do)",
+                stmt.frame_option.span,
+            )
+        if stmt.with_clause:
+            self._with_motion(stmt, base, relative)
+        else:
+            self._note_after_with(stmt)
+            self._plain_motion(stmt, base, relative)
+
+    def _plain_motion(self, stmt: MotionStmt, base: str, relative: bool) -> None:
+        zone = self._zone(stmt, base)
+        if base == "PTP":
+            target = self._relative(stmt, stmt.targets[0]) if relative else self._ptp_target(stmt)
+            self._emit(ir.JointMove, target, None, self._fields(stmt, zone))
+            return
+        via: Cartesian | None = None
+        if base == "CIRC":
+            start = self.track.cartesian, self.track.no_cartesian
+            via = self._point(stmt, stmt.targets[0], relative)
+            # The end point's missing components (and CIRC_REL's offsets) refer to the start.
+            self.track.cartesian, self.track.no_cartesian = start
+        target = self._point(stmt, stmt.targets[-1], relative)
+        self._note_default_speed(stmt)
+        make = ir.CircularMove if base == "CIRC" else ir.LinearMove
+        self._emit(make, target, via, self._fields(stmt, zone))
+
+    def _point(self, stmt: MotionStmt, expr: Expr, relative: bool) -> Cartesian:
+        target = self._relative(stmt, expr) if relative else self._cartesian(expr, stmt)
+        if not isinstance(target, Cartesian):
+            raise self._error(f"{stmt.keyword} needs a Cartesian target {{X ..,Y ..}}", expr.span)
+        return target
+
+    def _emit(
+        self,
+        make: Callable[..., ir.Instruction],
+        target: Target,
+        via: Cartesian | None,
+        fields: dict[str, Any],
+    ) -> None:
+        if isinstance(target, ir.JointTarget):
+            self.out.append(make(target=target, **fields))
+        else:
+            self.out.append(Pending(make, target, via, fields))
+
+    def _fields(self, stmt: MotionStmt, zone: ir.Zone) -> dict[str, Any]:
+        state = self.state
+        return {
+            "speed": state.speed,
+            "zone": zone,
+            "tool": state.tool,
+            "frame": state.frame,
+            "span": stmt.span,
+        }
+
+    def _note_default_speed(self, stmt: MotionStmt) -> None:
+        if not self.state.vel_cp_set:
+            message = (
+                f"{stmt.keyword} before any $VEL.CP: olp assumes {DEFAULT_VEL_CP} m/s, the value "
+                "BAS(#INITMOV) is reported to set; set $VEL.CP to be sure"
+            )
+            self._note(stmt.span, message, once="default-vel-cp")
+
+    # ---- approximation
+    def _zone(self, stmt: MotionStmt, base: str) -> ir.Zone:
+        if not stmt.approx:
+            return ir.FINE
+        self._check_approx(stmt, base)
+        if self.state.cdis_mm is None:
+            message = (
+                f"{' '.join(stmt.approx)} before any $APO.CDIS: olp does not know the "
+                "controller's approximation distance and programs an exact stop"
+            )
+            self._note(stmt.span, message)
+            return ir.FINE
+        if base != "PTP" and stmt.approx[0] in ("C_VEL", "C_ORI"):
+            self._note(stmt.span, f"{stmt.approx[0]} is approximated with the $APO.CDIS distance")
+        return ir.Zone(self.state.cdis_mm / 1000.0)
+
+    def _check_approx(self, stmt: MotionStmt, base: str) -> None:
+        approx = stmt.approx
+        spline = stmt.keyword in _SPLINE_MOTIONS
+        if spline and approx == ("C_SPL",):
+            return
+        if base == "PTP":
+            valid = approx[0] == "C_PTP" and (len(approx) == 1 or approx[1:] in _ONE_CP_APPROX)
+            rule = "PTP approximates with C_PTP, optionally followed by C_DIS, C_ORI or C_VEL"
+        else:
+            # The inline forms of KSS 8 write the keyword twice: LIN XP1 C_DIS C_DIS.
+            doubled = len(approx) == 2 and approx[0] == approx[1]
+            valid = approx in _ONE_CP_APPROX or (doubled and approx[:1] in _ONE_CP_APPROX)
+            rule = f"{stmt.keyword} approximates with one of C_DIS, C_ORI or C_VEL"
+        if not valid:
+            rule += "; spline motions with C_SPL" if spline else ""
+            raise self._error(f"invalid approximation {' '.join(approx)!r}: {rule}", stmt.span)
+
+    # ---- targets
+    def _position(self, expr: Expr, stmt: MotionStmt) -> tuple[Aggregate, str | None]:
+        """The position ``expr`` names (an inline aggregate or a declared point) and its name."""
+        if isinstance(expr, Aggregate):
+            return expr, None
+        named = isinstance(expr, Var) and not expr.selectors and not expr.name.startswith("$")
+        name = expr.name if isinstance(expr, Var) and named else None
+        return self._aggregate(expr, f"{stmt.keyword} to"), name
+
+    def _ptp_target(self, stmt: MotionStmt) -> Target:
+        agg, name = self._position(stmt.targets[0], stmt)
+        if is_axis_aggregate(agg):
+            return self._joint_target(agg, stmt, name)
+        return self._cartesian_from(agg, stmt, name, ptp=True)
+
+    def _cartesian(self, expr: Expr, stmt: MotionStmt) -> Cartesian:
+        agg, name = self._position(expr, stmt)
+        if is_axis_aggregate(agg):
+            raise self._error(f"{stmt.keyword} needs a Cartesian target {{X ..,Y ..}}", agg.span)
+        return self._cartesian_from(agg, stmt, name, ptp=False)
+
+    def _joint_target(self, agg: Aggregate, stmt: MotionStmt, name: str | None) -> ir.JointTarget:
+        members = self._members(agg, frozenset(AXES + EXTERNAL), "axis")
+        missing = [a for a in AXES if a not in members]
+        if missing:
+            raise self._error(
+                f"{stmt.keyword} to axis values needs all of A1..A6; missing {', '.join(missing)}",
+                agg.span,
+                hint="the other axes would keep the robot's current values, which olp cannot know",
+            )
+        degrees = tuple(self._number(members[a], a) for a in AXES)
+        self._check_external(members, stmt)
+        return self._went_to_axes(degrees, stmt, name)
+
+    def _went_to_axes(
+        self, degrees: tuple[float, ...], stmt: MotionStmt, name: str | None
+    ) -> ir.JointTarget:
+        self.track.at_axes(degrees, stmt.span.line)
+        return ir.JointTarget(joints=np.radians(degrees), name=name)
+
+    def _went_to(self, values: tuple[float, ...], stmt: MotionStmt) -> None:
+        self.track.at_position(values, stmt.span.line)
+
+    def _cartesian_from(
+        self, agg: Aggregate, stmt: MotionStmt, name: str | None, ptp: bool
+    ) -> Cartesian:
+        typed = agg.type_name is not None and agg.type_name.upper() != "FRAME"
+        allowed = CARTESIAN + EXTERNAL + (("S", "T") if typed or agg.type_name is None else ())
+        members = self._members(agg, frozenset(allowed), "position component")
+        values = self._complete(agg, members, stmt)
+        self._check_external(members, stmt)
+        config = self._record_status_turn(members, stmt, ptp)
+        self._went_to(values, stmt)
+        return Cartesian(values, name, config)
+
+    def _complete(
+        self, agg: Aggregate, members: dict[str, Expr], stmt: MotionStmt
+    ) -> tuple[float, ...]:
+        """X..C from the aggregate, missing ones from the previous Cartesian target."""
+        missing = [c for c in CARTESIAN if c not in members]
+        previous = self.track.cartesian
+        if previous is None:
+            if missing:
+                raise self._error(
+                    f"{stmt.keyword} target leaves out {', '.join(missing)}, which KRL takes from "
+                    f"the start position; olp cannot know it because {self.track.no_cartesian}",
+                    agg.span,
+                    hint="give all of X, Y, Z, A, B, C",
+                )
+            previous = (0.0,) * len(CARTESIAN)
+        return tuple(
+            self._number(members[c], c) if c in members else previous[i]
+            for i, c in enumerate(CARTESIAN)
+        )
+
+    # ---- relative (_REL) targets
+    def _relative(self, stmt: MotionStmt, expr: Expr) -> Target:
+        """A _REL target: offsets from the start position, made absolute (the start must be
+        known from the program text)."""
+        agg, _ = self._position(expr, stmt)
+        if is_axis_aggregate(agg):
+            if _BASE_MOTION[stmt.keyword] != "PTP":
+                raise self._error(f"{stmt.keyword} needs Cartesian offsets {{X ..}}", agg.span)
+            return self._relative_axes(agg, stmt)
+        option = stmt.frame_option.name.upper() if stmt.frame_option is not None else "BASE"
+        if option not in ("BASE", "TOOL"):
+            assert stmt.frame_option is not None
+            raise self._error("a _REL motion is relative to #BASE or #TOOL", stmt.frame_option.span)
+        members = self._members(agg, frozenset(CARTESIAN + EXTERNAL), "offset component")
+        start = self.track.cartesian
+        if start is None:
+            raise self._error(
+                f"{stmt.keyword} moves relative to the start position; olp cannot know it "
+                f"because {self.track.no_cartesian}",
+                stmt.span,
+            )
+        delta = tuple(self._number(members[c], c) if c in members else 0.0 for c in CARTESIAN)
+        self._check_external(members, stmt)
+        values = _offset(start, delta, option)
+        self._went_to(values, stmt)
+        return Cartesian(values)
+
+    def _relative_axes(self, agg: Aggregate, stmt: MotionStmt) -> ir.JointTarget:
+        members = self._members(agg, frozenset(AXES + EXTERNAL), "axis")
+        start = self.track.joints
+        if start is None:
+            raise self._error(
+                f"{stmt.keyword} moves the axes relative to where they are; olp cannot know "
+                f"that because {self.track.no_joints}",
+                stmt.span,
+            )
+        degrees = tuple(
+            start[i] + (self._number(members[a], a) if a in members else 0.0)
+            for i, a in enumerate(AXES)
+        )
+        self._check_external(members, stmt)
+        return self._went_to_axes(degrees, stmt, None)
+
+    def _check_external(self, members: dict[str, Expr], stmt: MotionStmt) -> None:
+        used = [e for e in EXTERNAL if e in members and self._number(members[e], e) != 0]
+        if used:
+            message = f"external axis values ({', '.join(used)}) are not supported yet; dropped"
+            self._note(stmt.span, message)
+
+    def _record_status_turn(
+        self, members: dict[str, Expr], stmt: MotionStmt, ptp: bool
+    ) -> ir.Configuration | None:
+        """S and T are kept (:attr:`KrlResult.status_turn`); a PTP target with both gets the
+        :class:`~olp.ir.Configuration` they ask for. LIN/CIRC get none: the controller ignores
+        S/T there (the branch follows from the start), so olp must not enforce one."""
+        status = self._integer(members["S"], "S (Status)") if "S" in members else None
+        turn = self._integer(members["T"], "T (Turn)") if "T" in members else None
+        if status is None and turn is None:
+            return None
+        record = StatusTurn(stmt.span, status, turn)
+        if ("st", record) not in self._reported:
+            self._reported.add(("st", record))
+            self.status_turn.append(record)
+        if not ptp or status is None or turn is None:
+            return None
+        try:
+            return configuration_from_status_turn(status, turn)
+        except ValueError as exc:
+            culprit = members["S"] if not 0 <= status < 32 else members["T"]
+            raise self._error(str(exc), culprit.span) from None
+
+    # ---- WITH
+    def _with_motion(self, stmt: MotionStmt, base: str, relative: bool) -> None:
+        """WITH assignments hold for this motion only (olp's reading of the KSS manual,
+        unverified); the next motion without WITH gets a note saying so."""
+        saved = self.state
+        for assignment in stmt.with_clause:
+            self._with_assignment(assignment)
+        during = self.state
+        self._plain_motion(stmt, base, relative)
+        self.state = saved
+        if (during.tool, during.frame) != (saved.tool, saved.frame):
+            line = stmt.span.line
+            self.track.lose_cartesian(f"the WITH at line {line} set $TOOL/$BASE for that motion")
+        self._after_with = stmt.span.line if during != saved else None
+
+    def _note_after_with(self, stmt: MotionStmt) -> None:
+        if self._after_with is not None:
+            self._note(
+                stmt.span,
+                f"olp takes the WITH values of line {self._after_with} as valid for that motion "
+                "only (unverified); this motion uses the values set before it",
+            )
+            self._after_with = None
+
+
+def _offset(start: tuple[float, ...], delta: tuple[float, ...], option: str) -> tuple[float, ...]:
+    """``start`` moved by ``delta`` (X..C, mm/deg): in the tool frame (#TOOL: start · delta), or
+    along and about the base axes (#BASE: positions add, the rotation is applied in the base)."""
+    start_pose, delta_pose = frame_to_pose(start), frame_to_pose(delta)
+    if option == "TOOL":
+        pose = start_pose @ delta_pose
+    else:
+        pose = start_pose.copy()
+        pose[:3, :3] = delta_pose[:3, :3] @ start_pose[:3, :3]
+        pose[:3, 3] = start_pose[:3, 3] + delta_pose[:3, 3]
+    return tuple(float(v) for v in pose_to_frame(pose))

@@ -1,0 +1,583 @@
+"""The core of KRL lowering: the controller state a program sets, and what one run shares.
+
+:class:`Core` holds the state (:class:`State`: speeds, approximation, tool, base; :class:`Track`:
+where the robot is, as far as the text tells), the variables, the reports (ignored lines, notes),
+value helpers that raise located errors, and the assignments of system variables (``$VEL``,
+``$APO``, ``$TOOL``, ``$BASE``, ``$OUT``, ...). :mod:`olp.frontends.krl_inline` (BAS and WITH),
+:mod:`olp.frontends.krl_motion` (motions) and :mod:`olp.frontends.krl_lower` (the statement walk,
+calls and loops) build on it, in that order.
+
+Cartesian targets are collected as KRL values (mm, deg) and converted to poses in one vectorised
+call at the end (:func:`build_instructions`), as milling programs have tens of thousands of them.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any, TypeVar
+
+import numpy as np
+
+from olp import ir
+from olp.errors import ParseError
+from olp.frontends.krl_ast import (
+    Aggregate,
+    Assign,
+    EnumValue,
+    Expr,
+    IgnoredLine,
+    Index,
+    Note,
+    Routine,
+    SourceSet,
+    StatusTurn,
+    Stmt,
+    Var,
+)
+from olp.frontends.krl_data import DataOps, KrlData, text_value
+from olp.frontends.krl_values import (
+    AXES,
+    CARTESIAN,
+    EXTERNAL,
+    POS_TYPES,
+    ArrayValue,
+    Bool,
+    Evaluator,
+    Signal,
+    Unknown,
+    Value,
+    Variables,
+    as_int,
+    as_number,
+    frame_values,
+)
+from olp.vendors.kuka import frame_to_pose
+
+DEFAULT_VEL_CP = 2.0
+"""m/s: ``$VEL.CP`` assumed before the program sets it (what ``BAS(#INITMOV, 0)`` is reported to
+set on KSS 8; unverified). A LIN/CIRC relying on it gets a note."""
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class KrlResult:
+    """What the KRL frontend read: the program and everything it did not lower as-is.
+
+    ``data_sources``: the data lists read besides the .src (its .dat, a ``$config.dat``).
+    """
+
+    program: ir.Program
+    ignored: tuple[IgnoredLine, ...] = ()
+    notes: tuple[Note, ...] = ()
+    status_turn: tuple[StatusTurn, ...] = ()
+    data_sources: tuple[str, ...] = ()
+
+
+# ------------------------------------------------------------------------------------------------
+# State
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class State:
+    """The controller state that motions pick up, as the program has set it so far."""
+
+    speed: ir.Speed = field(default_factory=lambda: ir.Speed(linear=DEFAULT_VEL_CP))
+    vel_cp_set: bool = False
+    vel_axis: dict[int, float] = field(default_factory=dict)  # percent per axis 1..6
+    acc_axis: dict[int, float] = field(default_factory=dict)
+    cdis_mm: float | None = None
+    tool: ir.Tool = field(default_factory=lambda: ir.FLANGE)
+    frame: ir.Frame = field(default_factory=lambda: ir.WORLD)
+
+
+@dataclass(slots=True)
+class Track:
+    """Where the robot is, as far as the program text tells: the start of the next motion,
+    for targets that leave components out and for _REL motions (and why it is unknown)."""
+
+    cartesian: tuple[float, ...] | None = None  # X, Y, Z (mm), A, B, C (deg) in the base
+    no_cartesian: str = "there is no earlier Cartesian target in the program"
+    joints: tuple[float, ...] | None = None  # A1..A6 (deg)
+    no_joints: str = "there is no earlier motion to axis values in the program"
+
+    def lose_cartesian(self, reason: str) -> None:
+        self.cartesian, self.no_cartesian = None, reason
+
+    def at_axes(self, degrees: tuple[float, ...], line: int) -> None:
+        self.cartesian = None
+        self.no_cartesian = f"the motion at line {line} went to axis values"
+        self.joints = degrees
+
+    def at_position(self, values: tuple[float, ...], line: int) -> None:
+        self.cartesian = values
+        self.joints = None
+        self.no_joints = f"the motion at line {line} went to a Cartesian position"
+
+
+@dataclass(frozen=True, slots=True)
+class Cartesian:
+    """A Cartesian target before its pose is computed: KRL values X..C (mm, deg)."""
+
+    values: tuple[float, ...]
+    name: str | None = None
+    config: ir.Configuration | None = None
+
+
+Target = ir.JointTarget | Cartesian
+
+
+@dataclass(frozen=True, slots=True)
+class Pending:
+    """A motion whose Cartesian target(s) get their poses in :func:`build_instructions`."""
+
+    make: Callable[..., ir.Instruction]
+    target: Target
+    via: Cartesian | None
+    fields: dict[str, Any]
+
+
+_F = TypeVar("_F", ir.Frame, ir.Tool)
+_DATA_TABLES = {"$BASE": "BASE_DATA", "$TOOL": "TOOL_DATA"}
+_TABLE_NAMES = {"TOOL_DATA": "TOOL_NAME", "BASE_DATA": "BASE_NAME"}
+SYSTEM_REASONS = {
+    "$BWDSTART": "$BWDSTART only matters when stepping backwards on the pendant",
+    "$APO.CPTP": "$APO.CPTP (%) is not lowered: olp approximates C_PTP with $APO.CDIS",
+    "$APO.CORI": "$APO.CORI is not lowered: olp approximates C_ORI with $APO.CDIS",
+    "$APO.CVEL": "$APO.CVEL is not lowered: olp approximates C_VEL with $APO.CDIS",
+    "$ACC.CP": "path acceleration ($ACC.CP) is not part of olp's IR",
+    "$ACC": "path acceleration ($ACC) is not part of olp's IR",
+    "$ADVANCE": "the advance run does not change the path",
+    "$ORI_TYPE": "the orientation control type is not lowered (olp interpolates orientation)",
+    "$CIRC_TYPE": "the orientation control type of CIRC is not lowered",
+    "$LOAD": "payload data are not part of olp's IR",
+    "$GEAR_JERK[]": "gear jerk limits are not part of olp's IR",
+    "$JERK": "jerk limits are not part of olp's IR",
+    "$COLLMON_TOL_PRO[]": "collision-detection tolerances are not modelled",
+}
+"""Why a system variable olp knows but does not lower is ignored (keys as :attr:`Var.key`)."""
+
+
+# ------------------------------------------------------------------------------------------------
+# What one run shares
+
+
+class Context:
+    """The files, routines, limits and naming rules of one run (shared by probes)."""
+
+    def __init__(
+        self,
+        sources: SourceSet,
+        routines: dict[str, Routine],
+        src: str,
+        dat: KrlData | None,
+        config: KrlData | None,
+        budget: int,
+    ) -> None:
+        self.sources = sources
+        self.routines = routines
+        self.called: set[str] = set()
+        self.main = next(iter(routines), "")
+        self.budget = self.remaining = budget
+        self.config = config
+        self.module_dat = dat
+        self._where = self._describe_files(src)
+
+    def _describe_files(self, src: str) -> str:
+        dat = (
+            "no .dat file beside it" if self.module_dat is None else data_file_name(self.module_dat)
+        )
+        config = "no $config.dat given" if self.config is None else data_file_name(self.config)
+        return f"{os.path.basename(src)} ({dat}; {config})"
+
+    def unknown_name(self, name: str) -> Unknown:
+        """Why ``name`` has no value: a controller variable, or declared nowhere olp looked."""
+        if name == "$H_POS":
+            return Unknown(
+                "$H_POS is not set by the program (the controller keeps it in $machine.dat, "
+                "which olp does not read)",
+                "set it in the program ($H_POS=XHOME) or move to XHOME directly",
+            )
+        if name.startswith("$"):
+            return Unknown(f"{name} is a controller variable olp does not track")
+        hints = []
+        if self.module_dat is None:
+            hints.append(
+                "points taught on the pendant are declared in the module's .dat, which must "
+                "sit beside the .src with the same name"
+            )
+        if self.config is None:
+            hints.append(
+                "XHOME, FHOME, PDEFAULT, TOOL_DATA and BASE_DATA are declared in the "
+                "controller's $config.dat: pass it (config_dat=...)"
+            )
+        return Unknown(f"{name} is not declared in {self._where}", "; ".join(hints) or None)
+
+    def spend(self, stmt: Stmt) -> None:
+        self.remaining -= 1
+        if self.remaining < 0:
+            raise self.sources.error(
+                f"the program expands to more than {self.budget:,} statements through "
+                "loops and calls; olp stops here",
+                stmt.span,
+                hint="olp unrolls FOR loops and inlines calls; a program this large is better "
+                "generated as straight-line code",
+            )
+
+
+def data_file_name(data: KrlData) -> str:
+    return os.path.basename(data.filename)
+
+
+# ------------------------------------------------------------------------------------------------
+# The core of a lowering
+
+
+class Core:
+    """State, variables, reports, values and system-variable assignments of one lowering."""
+
+    def __init__(self, ctx: Context, state: State, variables: Variables) -> None:
+        self.ctx = ctx
+        self.sources = ctx.sources
+        self.state = state
+        self.track = Track()
+        self.variables = variables
+        self.evaluator = Evaluator(variables, ctx.sources.snippet)
+        self.data = DataOps(variables, self.evaluator, ctx.sources)
+        self.out: list[ir.Instruction | Pending] = []
+        self.ignored: list[IgnoredLine] = []
+        self.notes: list[Note] = []
+        self.status_turn: list[StatusTurn] = []
+        self.call_stack: list[str] = []
+        self.loop_depth = 0
+        self.returned: tuple[str, int] | None = None  # (routine, line of its RETURN)
+        self.exiting: int | None = None  # line of an EXIT leaving the current loop
+        self._after_with: int | None = None  # line of the last motion whose WITH set anything
+        self._reported: set[tuple[Any, ...]] = set()
+        self._setters: dict[str, Callable[[str, Expr, Stmt], None]] = {
+            "$VEL.CP": self._set_vel_cp,
+            "$APO.CDIS": self._set_apo_cdis,
+            "$BASE": self._set_base,
+            "$TOOL": self._set_tool,
+            "$VEL": self._set_struct,
+            "$APO": self._set_struct,
+            "$VEL_AXIS[]": self._set_axis_percent,
+            "$ACC_AXIS[]": self._set_axis_percent,
+            "$OUT[]": self._set_output,
+            "$H_POS": self._set_home,
+            "$IPO_MODE": self._set_ipo_mode,
+        }
+
+    # ---- reporting
+    def _ignore(self, stmt: Stmt | Assign, reason: str) -> None:
+        key = ("ignored", stmt.span, reason)  # loops and calls lower a line many times
+        if key not in self._reported:
+            self._reported.add(key)
+            self.ignored.append(IgnoredLine(stmt.span, self.sources.snippet(stmt.span), reason))
+
+    def _note(self, span: ir.SourceSpan, message: str, once: str | None = None) -> None:
+        key = ("note", once) if once is not None else ("note", span, message)
+        if key not in self._reported:
+            self._reported.add(key)
+            self.notes.append(Note(span, message))
+
+    def _error(self, message: str, span: ir.SourceSpan, hint: str | None = None) -> ParseError:
+        return self.sources.error(message, span, hint)
+
+    # ---- values
+    def _value(self, expr: Expr) -> Value:
+        return self.evaluator.evaluate(expr)
+
+    def _number(self, expr: Expr, what: str) -> float:
+        value = self._value(expr)
+        number = as_number(value)
+        if number is None:
+            found = self.sources.snippet(expr.span)
+            why = f" ({value.reason})" if isinstance(value, Unknown) else ""
+            hint = value.hint if isinstance(value, Unknown) else None
+            message = f"{what} must be a constant number, found {found!r}{why}"
+            raise self._error(message, expr.span, hint)
+        if not math.isfinite(number):
+            raise self._error(f"{what} is out of range", expr.span)
+        return number
+
+    def _integer(self, expr: Expr, what: str, minimum: int = 0) -> int:
+        number = self._number(expr, what)
+        value = as_int(self._value(expr))
+        if value is None or value < minimum:
+            found = self.sources.snippet(expr.span)
+            raise self._error(f"{what} must be an integer >= {minimum}, found {found!r}", expr.span)
+        return int(number)
+
+    def _percent(self, expr: Expr, what: str) -> float:
+        percent = self._number(expr, f"{what} (%)")
+        if not 0 < percent <= 100:
+            raise self._error(f"{what} must be in (0, 100] %, found {percent:g}", expr.span)
+        return percent
+
+    def _single_index(self, target: Var, what: str, minimum: int = 1) -> int:
+        index = target.selectors[0]
+        if not isinstance(index, Index) or len(index.args) != 1 or index.args[0] is None:
+            raise self._error(f"{what} takes one index", target.span)
+        return self._integer(index.args[0], f"the index of {what}", minimum)
+
+    def _aggregate(self, expr: Expr, what: str, hint: str | None = None) -> Aggregate:
+        """The aggregate ``expr`` stands for (inline, or a variable's value)."""
+        value = self._value(expr)
+        if isinstance(value, Aggregate):
+            return value
+        found = self.sources.snippet(expr.span)
+        if isinstance(value, Unknown):
+            raise self._error(f"{what} {found!r}: {value.reason}", expr.span, value.hint or hint)
+        raise self._error(f"{what} {found!r}: not an aggregate {{...}}", expr.span, hint)
+
+    # ---- assignments
+    def _assign(self, stmt: Assign) -> None:
+        key = stmt.target.key
+        setter = self._setters.get(key)
+        if setter is not None:
+            setter(key, stmt.value, stmt)
+        elif key.startswith("$"):
+            generic = f"system variable {key.split('[')[0]} is not lowered yet"
+            self._ignore(stmt, SYSTEM_REASONS.get(key, generic))
+        elif self._is_signal(stmt.target):
+            self._signal_output(stmt)
+        else:
+            reason = self.data.assign(stmt)
+            if reason is not None:
+                self._ignore(stmt, reason)
+
+    def _set_vel_cp(self, name: str, value: Expr, stmt: Stmt) -> None:
+        self._vel_cp(self._number(value, "$VEL.CP (m/s)"), value.span)
+
+    def _vel_cp(self, speed: float, span: ir.SourceSpan) -> None:
+        if speed <= 0:
+            raise self._error(f"$VEL.CP (m/s) must be > 0, found {speed:g}", span)
+        new_speed = dataclasses.replace(self.state.speed, linear=speed)
+        self.state = dataclasses.replace(self.state, speed=new_speed, vel_cp_set=True)
+
+    def _set_apo_cdis(self, name: str, value: Expr, stmt: Stmt) -> None:
+        self._cdis(self._number(value, "$APO.CDIS (mm)"), value.span, "$APO.CDIS (mm)")
+
+    def _cdis(self, distance: float, span: ir.SourceSpan, what: str) -> None:
+        if distance < 0:
+            raise self._error(f"{what} must be >= 0", span)
+        self.state = dataclasses.replace(self.state, cdis_mm=distance)
+
+    def _set_struct(self, name: str, value: Expr, stmt: Stmt) -> None:
+        """``$VEL = {CP 0.5, ...}``: each component as its own assignment."""
+        if not isinstance(value, Aggregate):
+            raise self._error(f"{name} must be set from an aggregate {{...}} here", value.span)
+        unused = []
+        for member in value.members:
+            component = f"{name}.{member.name.upper()}"
+            setter = self._setters.get(component)
+            if setter is None:
+                unused.append(member.name.upper())
+            else:
+                setter(component, member.value, stmt)
+        if unused:
+            listed = ", ".join(unused)
+            self._ignore(stmt, f"{name} component(s) {listed} not lowered yet")
+
+    def _set_axis_percent(self, key: str, value: Expr, stmt: Stmt) -> None:
+        assert isinstance(stmt, Assign)
+        name = key.removesuffix("[]")
+        axis = self._single_index(stmt.target, name)
+        percent = self._percent(value, f"{name}[{axis}]")
+        if axis > len(AXES):
+            self._ignore(stmt, f"{name} of external axes is not lowered")
+            return
+        self._set_axes_percent(name, {axis: percent})
+
+    def _set_axes_percent(self, name: str, percents: dict[int, float]) -> None:
+        if name == "$VEL_AXIS":
+            vel_axis = {**self.state.vel_axis, **percents}
+            speed = dataclasses.replace(self.state.speed, joint=min(vel_axis.values()) / 100)
+            self.state = dataclasses.replace(self.state, vel_axis=vel_axis, speed=speed)
+        else:
+            acc_axis = {**self.state.acc_axis, **percents}
+            fraction = min(acc_axis.values()) / 100
+            speed = dataclasses.replace(self.state.speed, joint_acceleration=fraction)
+            self.state = dataclasses.replace(self.state, acc_axis=acc_axis, speed=speed)
+
+    def _all_axes(self, name: str, percent: float) -> None:
+        self._set_axes_percent(name, dict.fromkeys(range(1, len(AXES) + 1), percent))
+
+    def _set_output(self, key: str, value: Expr, stmt: Stmt) -> None:
+        assert isinstance(stmt, Assign)
+        self._output(self._single_index(stmt.target, "$OUT"), value, stmt)
+
+    def _output(self, index: int, value: Expr, stmt: Assign) -> None:
+        constant = self._value(value)
+        if not isinstance(constant, Bool):
+            self._ignore(stmt, "only constant TRUE/FALSE outputs are lowered")
+            return
+        self.out.append(ir.SetOutput(index=index, value=constant.value, span=stmt.span))
+
+    def _is_signal(self, target: Var) -> bool:
+        return not target.selectors and isinstance(self._value(target), Signal)
+
+    def _signal_output(self, stmt: Assign) -> None:
+        signal = self._value(stmt.target)
+        assert isinstance(signal, Signal)
+        if signal.io != "$OUT":
+            self._ignore(stmt, f"{stmt.target.name} is an input ({signal.io}) and cannot be set")
+            return
+        self._output(signal.index, stmt.value, stmt)
+
+    def _set_home(self, name: str, value: Expr, stmt: Stmt) -> None:
+        home = self._value(value)
+        self.variables.globals["$H_POS"] = home
+
+    def _set_ipo_mode(self, name: str, value: Expr, stmt: Stmt) -> None:
+        self._ipo_mode(self._value(value), value.span)
+
+    def _ipo_mode(self, mode: Value, span: ir.SourceSpan) -> None:
+        if isinstance(mode, EnumValue) and mode.name.upper() == "BASE":
+            return
+        found = self.sources.snippet(span)
+        raise self._error(
+            f"interpolation mode {found!r} is not supported: olp lowers motions of a robot-held "
+            "tool (#BASE), not an external (stationary) TCP (#TCP)",
+            span,
+        )
+
+    # ---- tools and bases
+    def _set_base(self, name: str, value: Expr, stmt: Stmt) -> None:
+        self._change_frame(self._frame_value(value, "$BASE", stmt.span, ir.Frame, ir.WORLD), stmt)
+
+    def _set_tool(self, name: str, value: Expr, stmt: Stmt) -> None:
+        self._change_tool(self._frame_value(value, "$TOOL", stmt.span, ir.Tool, ir.FLANGE), stmt)
+
+    def _change_frame(self, frame: ir.Frame, stmt: Stmt | Assign) -> None:
+        if frame != self.state.frame:
+            self._reset_start(dataclasses.replace(self.state, frame=frame), "$BASE", stmt.span)
+
+    def _change_tool(self, tool: ir.Tool, stmt: Stmt | Assign) -> None:
+        if tool != self.state.tool:
+            self._reset_start(dataclasses.replace(self.state, tool=tool), "$TOOL", stmt.span)
+
+    def _reset_start(self, state: State, name: str, span: ir.SourceSpan) -> None:
+        self.state = state
+        self.track.lose_cartesian(f"{name} changed at line {span.line}")
+
+    def _frame_value(
+        self, value: Expr, name: str, span: ir.SourceSpan, make: Callable[..., _F], null: _F
+    ) -> _F:
+        """A frame/tool from ``{FRAME: ...}`` (named after its line), a variable holding one (named
+        after it), ``BASE_DATA[n]`` (or ``TOOL_DATA[n]``) or ``$NULLFRAME``."""
+        table = _DATA_TABLES[name]
+        if isinstance(value, Var) and value.key == f"{table}[]":
+            return self._numbered(make, table, self._single_index(value, table), value.span)
+        if isinstance(value, Var) and value.key == "$NULLFRAME":
+            return null
+        constant = self._value(value)
+        if isinstance(constant, Aggregate):
+            pose = frame_to_pose(self._frame_aggregate(constant, name))
+            named = isinstance(value, Var) and not value.selectors
+            label = value.name if isinstance(value, Var) and named else None
+            return make(name=label or f"{name.strip('$').lower()}_l{span.line}", pose=pose)
+        why = f": {constant.reason}" if isinstance(constant, Unknown) else ""
+        raise self._error(
+            f"cannot evaluate {name} = {self.sources.snippet(value.span)!r}{why}",
+            value.span,
+            hint=f"olp reads {name} = {{FRAME: X ..,Y ..,Z ..,A ..,B ..,C ..}}, {table}[n] "
+            "or $NULLFRAME",
+        )
+
+    def _numbered(
+        self, make: Callable[..., _F], table: str, number: int, span: ir.SourceSpan
+    ) -> _F:
+        """``TOOL_DATA[n]``/``BASE_DATA[n]``: its value if a data list gives one (named after
+        ``TOOL_NAME[n,]``), else a reference the station resolves by number."""
+        array = self.variables.lookup(table)
+        element = array.elements.get((number,)) if isinstance(array, ArrayValue) else None
+        if element is None:
+            if self.ctx.config is not None:
+                raise self._error(
+                    f"{table}[{number}] has no value in {data_file_name(self.ctx.config)}",
+                    span,
+                    hint=f"{table} holds the tools/bases measured on the controller; is this the "
+                    "robot's $config.dat?",
+                )
+            return make(name=f"{table}[{number}]", number=number)
+        values = frame_values(element) if isinstance(element, Aggregate) else None
+        if values is None or isinstance(values, Unknown):
+            span = element_span(element, span)
+            raise self._error(f"{table}[{number}] is not a FRAME with numbers", span)
+        pose = frame_to_pose(values)
+        label = self._table_name(table, number) or f"{table}[{number}]"
+        return make(name=label, pose=pose, number=number)
+
+    def _table_name(self, table: str, number: int) -> str | None:
+        names = self.variables.lookup(_TABLE_NAMES[table])
+        if not isinstance(names, ArrayValue):
+            return None
+        row = names.elements.get((number, None), names.elements.get((number,)))
+        return None if row is None else text_value(row)
+
+    def _tool_number(self, number: int, stmt: Stmt | Assign, span: ir.SourceSpan) -> None:
+        tool = self._numbered(ir.Tool, "TOOL_DATA", number, span) if number else ir.FLANGE
+        self._change_tool(tool, stmt)
+
+    def _base_number(self, number: int, stmt: Stmt | Assign, span: ir.SourceSpan) -> None:
+        base = self._numbered(ir.Frame, "BASE_DATA", number, span) if number else ir.WORLD
+        self._change_frame(base, stmt)
+
+    def _frame_aggregate(self, agg: Aggregate, name: str) -> list[float]:
+        if agg.type_name is not None and agg.type_name.upper() not in POS_TYPES:
+            raise self._error(f"{name} needs a FRAME aggregate, not {agg.type_name}", agg.span)
+        typed = agg.type_name is not None and agg.type_name.upper() != "FRAME"
+        allowed = CARTESIAN + (("S", "T", *EXTERNAL) if typed else ())
+        members = self._members(agg, frozenset(allowed), f"{name} component")
+        return [self._number(members[c], f"{name}.{c}") if c in members else 0.0 for c in CARTESIAN]
+
+    def _members(self, agg: Aggregate, allowed: frozenset[str], what: str) -> dict[str, Expr]:
+        """The aggregate's members by upper-case name; unknown or repeated names are errors."""
+        members: dict[str, Expr] = {}
+        for member in agg.members:
+            key = member.name.upper()
+            if key not in allowed:
+                expected = ", ".join(sorted(allowed))
+                message = f"unknown {what} {member.name!r} (expected one of {expected})"
+                raise self._error(message, member.span)
+            if key in members:
+                raise self._error(f"{what} {member.name!r} is given twice", member.span)
+            members[key] = member.value
+        return members
+
+
+def element_span(element: Value, default: ir.SourceSpan) -> ir.SourceSpan:
+    span = getattr(element, "span", None)
+    return span if isinstance(span, ir.SourceSpan) else default
+
+
+def build_instructions(out: Sequence[ir.Instruction | Pending]) -> tuple[ir.Instruction, ...]:
+    """The instructions, with all Cartesian poses computed in one vectorised call."""
+    values = []
+    for item in out:
+        if isinstance(item, Pending):
+            assert isinstance(item.target, Cartesian)
+            values.append(item.target.values)
+            if item.via is not None:
+                values.append(item.via.values)
+    poses = iter(frame_to_pose(np.array(values, dtype=np.float64).reshape(-1, 6)))
+    built: list[ir.Instruction] = []
+    for item in out:
+        if not isinstance(item, Pending):
+            built.append(item)
+            continue
+        target = item.target
+        assert isinstance(target, Cartesian)
+        fields = dict(item.fields)
+        fields["target"] = ir.CartesianTarget(
+            pose=next(poses), config=target.config, name=target.name
+        )
+        if item.via is not None:
+            via = item.via
+            fields["via"] = ir.CartesianTarget(pose=next(poses), config=via.config, name=via.name)
+        built.append(item.make(**fields))
+    return tuple(built)
