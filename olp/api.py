@@ -7,6 +7,7 @@ Stages, each a plain function: :func:`load_station`, :func:`parse` (file -> ir.P
 from __future__ import annotations
 
 import builtins
+import dataclasses
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -15,6 +16,7 @@ from typing import TYPE_CHECKING, Protocol
 from olp.diagnostics import Diagnostic, has_errors
 from olp.errors import UsageError
 from olp.ir import Program, SourceSpan
+from olp.passes.collide import CollisionOptions
 from olp.passes.resolve import CompiledProgram, ResolveOptions, resolve
 from olp.station.loader import load_station as _load_station
 from olp.station.model import Station
@@ -129,14 +131,31 @@ FRONTENDS: dict[str, Callable[[Path, _ParseContext], ParsedProgram]] = {
 """Program file suffix -> frontend."""
 
 
+_DEFAULT_COLLISIONS = CollisionOptions()
+"""Collision checks run by default (pass ``collisions=None`` to skip them)."""
+
+
 def compile(
-    program: Program, station: Station, options: ResolveOptions | None = None
+    program: Program,
+    station: Station,
+    options: ResolveOptions | None = None,
+    *,
+    collisions: CollisionOptions | None = _DEFAULT_COLLISIONS,
+    other_times: Mapping[str, float] | None = None,
 ) -> CompiledProgram:
-    """Resolve and time ``program`` on ``station``. Never raises on a bad program."""
+    """Resolve, check collisions and time ``program`` on ``station``. Never raises on a bad
+    program. ``collisions``: options of the collision check (default options if not given),
+    or None to skip it; ``other_times``: seconds per non-motion instruction kind (see
+    :data:`olp.passes.timing.DEFAULT_TIMES`)."""
     from olp.passes.timing import time_program
 
     compiled = resolve(program, station, options)
-    return time_program(compiled) if compiled.ok else compiled
+    if collisions is not None:
+        from olp.passes.collide import check_collisions
+
+        found = tuple(check_collisions(compiled, collisions))
+        compiled = dataclasses.replace(compiled, diagnostics=compiled.diagnostics + found)
+    return time_program(compiled, other_times) if compiled.ok else compiled
 
 
 @dataclass(frozen=True, slots=True)
@@ -165,6 +184,7 @@ def build(
     params: Mapping[str, object] | None = None,
     csv_options: CsvOptions | None = None,
     krl_config_dat: str | Path | None = None,
+    collisions: CollisionOptions | None = _DEFAULT_COLLISIONS,
 ) -> BuildResult:
     """Compile ``program`` on ``station`` and render it through ``post``.
 
@@ -187,7 +207,7 @@ def build(
         )
         program, notes = parsed.program, parsed.notes
     manifest = find_post(post)
-    compiled = compile(program, station, options)
+    compiled = compile(program, station, options, collisions=collisions)
     diagnostics = notes + compiled.diagnostics
     if not compiled.ok:
         return BuildResult(compiled, manifest.name, diagnostics)

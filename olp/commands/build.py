@@ -7,7 +7,12 @@ import math
 import sys
 from typing import TYPE_CHECKING
 
-from olp.commands.check import add_check_options, resolve_options
+from olp.commands.check import (
+    add_check_options,
+    add_collision_options,
+    collision_options,
+    resolve_options,
+)
 from olp.commands.common import EXIT_OK, EXIT_PROGRAM_ERRORS, print_diagnostics, require_files
 
 if TYPE_CHECKING:
@@ -42,6 +47,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--sarif", help="write the diagnostics as SARIF 2.1.0 to this file")
     parser.add_argument("-q", "--quiet", action="store_true", help="print errors only")
     add_check_options(parser)
+    add_collision_options(parser)
     add_program_options(parser)
 
 
@@ -144,6 +150,7 @@ def run(args: argparse.Namespace) -> int:
         params=program_params(args),
         csv_options=csv_options(args),
         krl_config_dat=args.config_dat,
+        collisions=collision_options(args),
     )
     print_diagnostics(result.diagnostics, args.program, quiet=args.quiet)
     write_outputs(args, result)

@@ -19,6 +19,7 @@ from olp.commands.common import (
 
 if TYPE_CHECKING:
     from olp.api import BuildResult
+    from olp.passes.collide import CollisionOptions
     from olp.passes.resolve import ResolveOptions
 
 NAME = "check"
@@ -29,6 +30,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("station", help="station YAML file")
     parser.add_argument("program", help="program file")
     add_check_options(parser)
+    add_collision_options(parser)
     parser.add_argument("--report", help="write a JSON report to this file")
     parser.add_argument("--sarif", help="write the diagnostics as SARIF 2.1.0 to this file")
     parser.add_argument("-q", "--quiet", action="store_true", help="print errors only")
@@ -52,6 +54,49 @@ def add_check_options(parser: argparse.ArgumentParser) -> None:
     )
 
 
+def add_collision_options(parser: argparse.ArgumentParser) -> None:
+    """Options of the collision check (shared with ``olp build`` and ``olp time``)."""
+    group = parser.add_argument_group("collisions")
+    group.add_argument(
+        "--no-collisions",
+        dest="collisions",
+        action="store_false",
+        help="skip the collision check",
+    )
+    group.add_argument(
+        "--clearance",
+        type=float,
+        default=0.0,
+        metavar="MM",
+        help="bodies closer than this count as colliding (default 0)",
+    )
+    group.add_argument(
+        "--allow-contact",
+        action="append",
+        default=[],
+        metavar="A,B",
+        help="two bodies that may touch (link_3, a tool, part or fixture name); repeatable",
+    )
+
+
+def collision_options(args: argparse.Namespace) -> CollisionOptions | None:
+    """The collision options the command line asks for, or None with --no-collisions."""
+    from olp.errors import UsageError
+    from olp.passes.collide import CollisionOptions
+
+    if not args.collisions:
+        return None
+    if not (args.clearance >= 0.0):
+        raise UsageError(f"--clearance must be >= 0 mm, got {args.clearance}")
+    pairs = []
+    for text in args.allow_contact:
+        names = [n.strip() for n in text.split(",")]
+        if len(names) != 2 or not all(names):
+            raise UsageError(f"--allow-contact takes two names 'A,B', got {text!r}")
+        pairs.append((names[0], names[1]))
+    return CollisionOptions(clearance_m=args.clearance / 1000.0, allowed_pairs=tuple(pairs))
+
+
 def resolve_options(args: argparse.Namespace) -> ResolveOptions:
     """The :class:`~olp.passes.resolve.ResolveOptions` the check options ask for."""
     from olp.passes.resolve import ResolveOptions
@@ -68,7 +113,9 @@ def run(args: argparse.Namespace) -> int:
     require_files(args.station, args.program)
     station = load_station(args.station)
     parsed = parse_program(args, station)
-    compiled = compile(parsed.program, station, resolve_options(args))
+    compiled = compile(
+        parsed.program, station, resolve_options(args), collisions=collision_options(args)
+    )
     result = BuildResult(compiled, "-", parsed.notes + compiled.diagnostics)
     print_diagnostics(result.diagnostics, args.program, quiet=args.quiet)
     write_outputs(args, result)

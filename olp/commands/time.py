@@ -17,7 +17,12 @@ import sys
 from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING
 
-from olp.commands.check import add_check_options, resolve_options
+from olp.commands.check import (
+    add_check_options,
+    add_collision_options,
+    collision_options,
+    resolve_options,
+)
 from olp.commands.common import (
     EXIT_OK,
     EXIT_PROGRAM_ERRORS,
@@ -64,6 +69,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "named call (call:NAME); repeatable, e.g. --time call:SprayOn=1.5",
     )
     add_check_options(parser)
+    add_collision_options(parser)
     from olp.commands.build import add_program_options
 
     add_program_options(parser)
@@ -73,9 +79,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from olp.api import load_station
-    from olp.passes.resolve import resolve
-    from olp.passes.timing import time_program
+    from olp.api import compile, load_station
 
     require_files(args.station, args.program)
     linear = _speed_list(args.sweep_linear, "--sweep-linear", "mm/s", 1e-3)
@@ -89,9 +93,13 @@ def run(args: argparse.Namespace) -> int:
         require_matplotlib()
     station = load_station(args.station)
     parsed = parse_program(args, station)
-    compiled = resolve(parsed.program, station, resolve_options(args))
-    if compiled.ok:
-        compiled = time_program(compiled, other_times)
+    compiled = compile(
+        parsed.program,
+        station,
+        resolve_options(args),
+        collisions=collision_options(args),
+        other_times=other_times,
+    )
     print_diagnostics(parsed.notes + compiled.diagnostics, args.program, quiet=args.quiet)
     if not compiled.ok:
         return EXIT_PROGRAM_ERRORS

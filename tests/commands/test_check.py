@@ -62,3 +62,30 @@ def test_sarif_output_is_deterministic(tmp_path: Path) -> None:
     main(["check", CELL, prog, "--sarif", str(tmp_path / "a.sarif"), "-q"])
     main(["check", CELL, prog, "--sarif", str(tmp_path / "b.sarif"), "-q"])
     assert (tmp_path / "a.sarif").read_bytes() == (tmp_path / "b.sarif").read_bytes()
+
+
+COLLISION_CELL = str(REPO / "stations" / "kr6_milling_collision_cell.yaml")
+MILLING = str(REPO / "examples" / "milling.src")
+
+
+def test_collisions_are_checked_by_default_and_can_be_switched_off(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    # The job-5 program on the collision cell: turning the tool to A -160 on line 9 swings the
+    # spindle into a clamp (the job-5 inline $TOOL is matched to the station spindle by TCP).
+    assert main(["check", COLLISION_CELL, MILLING, "-q"]) == 1
+    err = capsys.readouterr().err
+    assert "milling.src:9:1: error[collision]: tool 'spindle' hits fixture 'clamp_x_plus'" in err
+    # allowed contact, or no collision check at all, lets it pass
+    allowed = ["--allow-contact", "spindle,clamp_x_plus"]
+    assert main(["check", COLLISION_CELL, MILLING, "-q", *allowed]) == 0
+    assert main(["check", COLLISION_CELL, MILLING, "-q", "--no-collisions"]) == 0
+    # a clearance makes the check stricter: a link near another clamp is reported too
+    args = ["check", COLLISION_CELL, MILLING, "-q", *allowed, "--clearance", "200"]
+    assert main(args) == 1
+    assert "closer than 200.0 mm" in capsys.readouterr().err
+
+
+def test_allow_contact_needs_two_names(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["check", COLLISION_CELL, MILLING, "--allow-contact", "link_3"]) == 2
+    assert "two names" in capsys.readouterr().err

@@ -1,0 +1,357 @@
+"""A collision scene: the robot's links, its tool and carried parts, and the station's objects as
+one pinocchio ``GeometryModel`` (coal shapes), grouped into named bodies and checked pairs.
+
+Everything is expressed in the robot's kinematic base frame (the frame of its pinocchio chain):
+world objects are placed by ``inv(robot.base) @ pose``, so the chain's own joint frames carry the
+moving bodies and distances are those of the world.
+
+Each checked :class:`BodyPair` carries ``weights`` (nq,): a bound on how far any point of one body
+can move relative to the other per unit of each chain joint (m/rad for revolute joints, m/m for
+prismatic ones). For a joint-space step ``dq`` no point moves further than ``|dq| · weights`` —
+see :class:`DisplacementBound` for the derivation.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from olp.collision.shapes import coal_geometry, reach
+from olp.geometry import inv
+from olp.station.model import Robot, Shape
+
+FloatArray = NDArray[np.float64]
+
+Role = Literal["link", "tool", "carried", "part", "fixture"]
+PairKind = Literal["collision", "self_collision"]
+
+_ROBOT_SIDE: frozenset[str] = frozenset({"link", "tool", "carried"})
+
+
+class UnsupportedChain(ValueError):
+    """A chain joint whose point motion the advancement cannot bound (not revolute/prismatic)."""
+
+
+@dataclass(frozen=True, slots=True)
+class Body:
+    """A named rigid body of the scene.
+
+    ``joint``: the pinocchio joint it moves with (0: fixed in the world). ``geometries``: its
+    geometry object ids. ``reach``: largest distance (m) of its points from its joint's origin.
+    """
+
+    name: str
+    label: str
+    role: Role
+    joint: int
+    geometries: tuple[int, ...]
+    reach: float
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class BodyPair:
+    """Two bodies whose distance is checked: ``first`` moves with the robot.
+
+    ``geometry_pairs``: indices into the geometry model's collision pairs (every shape of one
+    body against every shape of the other). ``weights`` (nq,): point displacement bound per
+    unit of chain-joint motion, m/rad (revolute) or m/m (prismatic).
+    """
+
+    first: int
+    second: int
+    kind: PairKind
+    geometry_pairs: tuple[int, ...]
+    weights: FloatArray
+
+
+@dataclass(frozen=True, slots=True)
+class Placed:
+    """Shapes placed rigidly on a body: ``pose`` (4, 4) in the body's frame (the world for a
+    station object, the flange for a tool or a carried part)."""
+
+    name: str
+    role: Role
+    pose: FloatArray
+    shapes: tuple[Shape, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class PairRules:
+    """Which pairs are not checked.
+
+    ``allowed``: pairs of body names (either order) never checked. ``tool_touches_parts``: the
+    tool (not the links) may touch and enter parts. ``self_collision``: check the robot's bodies
+    against each other (adjacent joints never are). ``home_contacts``: the robot-side pairs
+    (links and tool) closer than ``contact_below`` (m) at the robot's home position are
+    allowed, as the overlapping capsules of a simplified collision model are.
+    """
+
+    allowed: frozenset[frozenset[str]] = frozenset()
+    tool_touches_parts: bool = True
+    self_collision: bool = True
+    home_contacts: bool = True
+    contact_below: float = 0.0
+
+
+class Scene:
+    """The pinocchio model with its geometry, the bodies and the checked pairs."""
+
+    def __init__(
+        self,
+        model: Any,
+        geometry: Any,
+        bodies: Sequence[Body],
+        chain_joints: Callable[[FloatArray], FloatArray],
+    ) -> None:
+        import pinocchio as pin
+
+        self.chain_joints = chain_joints
+        """Controller joints (..., dof) -> the model's configuration (..., nq)."""
+        self.model = model
+        self.geometry = geometry
+        self.bodies = tuple(bodies)
+        self.pairs: tuple[BodyPair, ...] = ()
+        self._pin = pin
+        self._data = model.createData()
+        self._gdata: Any = None
+
+    def finalize(self, pairs: Sequence[BodyPair]) -> None:
+        """Set the checked pairs (their geometry pairs must be registered already)."""
+        self.pairs = tuple(pairs)
+        self._gdata = self._pin.GeometryData(self.geometry)
+
+    def place(self, q_chain: FloatArray) -> None:
+        """Move every geometry to chain configuration ``q_chain`` (nq,)."""
+        self._pin.forwardKinematics(self.model, self._data, q_chain)
+        self._pin.updateGeometryPlacements(self.model, self._data, self.geometry, self._gdata)
+
+    def distance(self, pair: BodyPair) -> float:
+        """Signed distance (m, negative = penetration depth) of a pair at the last
+        :meth:`place`: the least over its shape pairs."""
+        compute, geometry, gdata = self._pin.computeDistance, self.geometry, self._gdata
+        return min(compute(geometry, gdata, k).min_distance for k in pair.geometry_pairs)
+
+    def name_of(self, pair: BodyPair) -> tuple[str, str]:
+        return self.bodies[pair.first].label, self.bodies[pair.second].label
+
+
+def build_scene(
+    robot: Robot,
+    tool: Placed | None,
+    carried: Sequence[Placed],
+    objects: Sequence[Placed],
+    rules: PairRules,
+) -> Scene:
+    """The scene of ``robot`` with its ``tool`` and ``carried`` parts (poses in the flange frame)
+    among world ``objects`` (poses in the world frame), with the pairs ``rules`` check.
+
+    Raises :class:`UnsupportedChain` for chain joints other than revolute or prismatic.
+    """
+    import pinocchio as pin
+
+    model = robot.kinematics.chain_model()
+    builder = _Builder(pin.GeometryModel())
+    for link, (joint, frame) in _link_frames(model, robot).items():
+        shapes = tuple(s for s in robot.collision if s.link == link)
+        builder.add(Placed(link, "link", frame, shapes), f"robot {link}", joint)
+    flange_joint, flange = _flange(model, robot)
+    if tool is not None:
+        builder.add(
+            dataclasses.replace(tool, pose=flange @ tool.pose), f"tool {tool.name!r}", flange_joint
+        )
+    for part in carried:
+        label = f"carried part {part.name!r}"
+        builder.add(dataclasses.replace(part, pose=flange @ part.pose), label, flange_joint)
+    world = inv(robot.base)
+    for obj in objects:
+        builder.add(dataclasses.replace(obj, pose=world @ obj.pose), f"{obj.role} {obj.name!r}", 0)
+    scene = Scene(model, builder.geometry, builder.bodies, robot.kinematics.chain_joints)
+    bound = DisplacementBound(model, robot)
+    candidates = _candidate_pairs(model, builder.bodies, rules)
+    scene.finalize([_register(scene, i, j, bound) for i, j in candidates])
+    if rules.home_contacts and rules.self_collision:
+        scene.pairs = _without_home_contacts(scene, robot, rules.contact_below)
+    return scene
+
+
+@dataclass(slots=True)
+class _Builder:
+    """Collects geometry objects and the bodies they make up."""
+
+    geometry: Any
+    bodies: list[Body] = field(default_factory=list)
+
+    def add(self, placed: Placed, label: str, joint: int) -> None:
+        """Add a body made of ``placed.shapes`` at ``placed.pose`` in ``joint``'s frame."""
+        import pinocchio as pin
+
+        if not placed.shapes:
+            return
+        ids = []
+        for k, shape in enumerate(placed.shapes):
+            placement = pin.SE3(placed.pose @ shape.pose)
+            obj = pin.GeometryObject(f"{placed.name}#{k}", joint, placement, coal_geometry(shape))
+            ids.append(self.geometry.addGeometryObject(obj))
+        radius = max(reach(s, placed.pose) for s in placed.shapes)
+        self.bodies.append(Body(placed.name, label, placed.role, joint, tuple(ids), radius))
+
+
+def _flange(model: Any, robot: Robot) -> tuple[int, FloatArray]:
+    """The joint the flange moves with and the flange pose (4, 4) in that joint's frame."""
+    frame = model.frames[model.getFrameId("tool0")]
+    return int(frame.parentJoint), np.asarray(frame.placement.homogeneous) @ robot.flange_in_tool0
+
+
+def _link_frames(model: Any, robot: Robot) -> dict[str, tuple[int, FloatArray]]:
+    """Each collision link name -> (joint, link frame (4, 4) in that joint's frame)."""
+    out: dict[str, tuple[int, FloatArray]] = {"base": (0, np.eye(4))}
+    for link in {s.link for s in robot.collision} - {"base"}:
+        frame = model.frames[model.getFrameId(link)]
+        out[link] = (int(frame.parentJoint), np.asarray(frame.placement.homogeneous))
+    return dict(sorted(out.items(), key=lambda item: (item[1][0], item[0])))
+
+
+def _register(scene: Scene, i: int, j: int, bound: DisplacementBound) -> BodyPair:
+    import pinocchio as pin
+
+    a, b = scene.bodies[i], scene.bodies[j]
+    if a.joint == 0:
+        i, j, a, b = j, i, b, a
+    start = len(scene.geometry.collisionPairs)
+    for ga in a.geometries:
+        for gb in b.geometries:
+            scene.geometry.addCollisionPair(pin.CollisionPair(ga, gb))
+    count = len(a.geometries) * len(b.geometries)
+    kind: PairKind = "self_collision" if b.role in _ROBOT_SIDE else "collision"
+    return BodyPair(i, j, kind, tuple(range(start, start + count)), bound.pair(a, b))
+
+
+def _candidate_pairs(model: Any, bodies: Sequence[Body], rules: PairRules) -> list[tuple[int, int]]:
+    """Body index pairs to check: something moving against anything it could meet."""
+    out = []
+    for i, a in enumerate(bodies):
+        for j in range(i + 1, len(bodies)):
+            b = bodies[j]
+            if _checked(model, a, b, rules):
+                out.append((i, j))
+    return out
+
+
+def _checked(model: Any, a: Body, b: Body, rules: PairRules) -> bool:
+    if a.joint == b.joint or frozenset((a.name, b.name)) in rules.allowed:
+        return False  # one rigid body (or two fixed ones), or declared allowed
+    robot_side = a.role in _ROBOT_SIDE and b.role in _ROBOT_SIDE
+    if robot_side:
+        adjacent = model.parents[a.joint] == b.joint or model.parents[b.joint] == a.joint
+        return rules.self_collision and not adjacent
+    roles = {a.role, b.role}
+    return not (rules.tool_touches_parts and roles == {"tool", "part"})
+
+
+def _without_home_contacts(scene: Scene, robot: Robot, below: float) -> tuple[BodyPair, ...]:
+    """The scene's pairs without the link/tool pairs closer than ``below`` (m) at home."""
+    scene.place(np.asarray(robot.kinematics.chain_joints(robot.home), dtype=np.float64))
+    fixed = {"link", "tool"}
+
+    def touching(pair: BodyPair) -> bool:
+        roles = {scene.bodies[pair.first].role, scene.bodies[pair.second].role}
+        return pair.kind == "self_collision" and roles <= fixed and scene.distance(pair) < below
+
+    return tuple(p for p in scene.pairs if not touching(p))
+
+
+# --------------------------------------------------------------------------------------------
+# Displacement bounds
+
+
+_REVOLUTE = frozenset(
+    {"JointModelRX", "JointModelRY", "JointModelRZ", "JointModelRevoluteUnaligned"}
+)
+_PRISMATIC = frozenset(
+    {"JointModelPX", "JointModelPY", "JointModelPZ", "JointModelPrismaticUnaligned"}
+)
+
+
+def joint_kinds(model: Any) -> list[str]:
+    """``"revolute"`` or ``"prismatic"`` for each joint 1..njoints-1 of a chain model; raises
+    :class:`UnsupportedChain` for any other kind of joint."""
+    kinds = []
+    for j in range(1, model.njoints):
+        name = model.joints[j].shortname()
+        if name not in _REVOLUTE | _PRISMATIC:
+            raise UnsupportedChain(
+                f"joint {model.names[j]!r} ({name}) is neither revolute nor prismatic"
+            )
+        kinds.append("revolute" if name in _REVOLUTE else "prismatic")
+    return kinds
+
+
+class DisplacementBound:
+    """Bounds on how far points of the scene's bodies move per unit of chain-joint motion.
+
+    Along a straight joint-space step ``dq`` a point p of a body on joint ``b`` moves relative to
+    the frame of joint ``c`` (an ancestor, 0 = the world) with speed at most
+    ``sum_m |dq_m| · w_m`` over the joints m from c (exclusive) to b: a revolute joint turns p
+    about its axis, which passes through its origin ``o_m``, so p's speed from it is
+    ``|dq_m| · dist(p, axis) <= |dq_m| · |p - o_m|``, and ``|p - o_m| <= reach + sum
+    |o_l - o_parent(l)|`` over the joints l after m up to b (constant joint offsets; a
+    prismatic joint l adds its largest travel within the limits); a prismatic joint moves every
+    point by exactly ``|dq_m|``. Two bodies are bounded relative to their deepest common joint:
+    the sum of both bounds. The distance between two bodies changes no faster than their
+    relative point motion.
+    """
+
+    def __init__(self, model: Any, robot: Robot) -> None:
+        kinds = ["fixed", *joint_kinds(model)]
+        self._model = model
+        self._kinds = kinds
+        self._offsets = [
+            float(np.linalg.norm(model.jointPlacements[j].translation))
+            for j in range(model.njoints)
+        ]
+        self._travel = _prismatic_travel(model, robot, kinds)
+
+    def _chain_to(self, joint: int) -> list[int]:
+        out = []
+        while joint > 0:
+            out.append(joint)
+            joint = self._model.parents[joint]
+        return out[::-1]
+
+    def body(self, body: Body, below: int = 0) -> FloatArray:
+        """Weights (nq,) of ``body``'s motion relative to joint ``below`` (0: the world)."""
+        w = np.zeros(self._model.nq)
+        path = self._chain_to(body.joint)
+        path = path[path.index(below) + 1 :] if below in path else path
+        for k, m in enumerate(path):
+            q_index = self._model.joints[m].idx_q
+            if self._kinds[m] == "prismatic":
+                w[q_index] += 1.0
+            else:
+                lever = sum(self._offsets[n] + self._travel[n] for n in path[k + 1 :])
+                w[q_index] += body.reach + lever
+        return w
+
+    def pair(self, a: Body, b: Body) -> FloatArray:
+        """Weights (nq,) of the relative motion of two bodies."""
+        common = set(self._chain_to(a.joint)) & set(self._chain_to(b.joint))
+        c = max(common, default=0)
+        return self.body(a, c) + self.body(b, c)
+
+
+def _prismatic_travel(model: Any, robot: Robot, kinds: list[str]) -> list[float]:
+    """Largest |q| (m) of each prismatic chain joint within the robot's joint limits (0 for
+    revolute joints). Chain joints are ``C · q`` (a joint coupling), so ``|C| · max|q|``."""
+    coupling = np.asarray(robot.kinematics.chain_joints(np.eye(robot.dof)), dtype=np.float64).T
+    largest = np.maximum(np.abs(robot.limits.lower), np.abs(robot.limits.upper))
+    chain = np.abs(coupling) @ largest
+    out = [0.0] * model.njoints
+    for j, kind in enumerate(kinds):
+        if kind == "prismatic":
+            out[j] = float(chain[model.joints[j].idx_q])
+    return out

@@ -1,0 +1,393 @@
+"""Collide: every motion of a compiled program checked for collisions, between samples too.
+
+What is checked (coal through pinocchio's ``GeometryModel``; meshes as convex hulls):
+
+* the robot's links, its current tool and any carried part against the station's parts and
+  fixtures (kind ``collision``);
+* the robot's links, tool and carried parts against each other (kind ``self_collision``), except
+  bodies on the same or on adjacent joints (the tool and a carried part sit on the last joint, so
+  they may touch the last two links), pairs already closer than the clearance at the home
+  position (the overlapping capsules of a simplified model) and declared ``allowed_pairs``;
+* by default the tool may touch and enter *parts* (machining, welding, screwing); it is checked
+  against fixtures.
+
+Along every motion the piecewise-linear joint path between the resolve pass's samples is proven
+free by conservative advancement (:mod:`olp.collision.advance`): if nothing is reported, every
+checked pair keeps a signed distance above ``clearance_m - tolerance_m`` everywhere on that path,
+a thin wall between two samples included. For a joint move that path is the motion itself
+(straight in joint space). For a linear move the real TCP line is sampled every ``step_m`` /
+``step_rad`` and joined by joint-space chords; between samples the chord deviates from the
+exact path by a second-order amount: :func:`olp.collision.chord.chord_deviation` estimates it
+(at the default 5 mm step, a few hundredths of a millimetre of link-point motion on the bundled
+milling toolpath, below the default tolerance); ``clearance_m`` covers it where that matters.
+Rounded corners (zones) are not modelled: the checked path is the programmed one.
+
+Pick and place: an :class:`Attachment` makes the tool carry a station part from one instruction
+to another; the part keeps the pose relative to the flange it had when gripped and stays where
+it was let go.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from olp.diagnostics import Diagnostic
+from olp.geometry import inv
+from olp.ir import FLANGE, Tool, is_motion
+
+if TYPE_CHECKING:
+    from olp.collision.advance import Hit
+    from olp.collision.scene import Placed, Scene
+    from olp.passes.resolve import CompiledProgram, Step
+    from olp.station.model import Station
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True, slots=True)
+class Attachment:
+    """The tool carries station part (or fixture) ``part`` from instruction ``grasp`` up to, not
+    including, instruction ``release`` (None: to the end). It keeps the pose relative to the
+    flange it has when gripped (at the robot's position before instruction ``grasp``) and stays
+    where the robot lets it go."""
+
+    part: str
+    grasp: int
+    release: int | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class CollisionOptions:
+    """Settings of the collision check.
+
+    ``clearance_m``: bodies closer than this (m) collide (0: only overlap counts).
+    ``tolerance_m``: the resolution: a pair closer than ``clearance_m - tolerance_m`` anywhere
+    on a motion is always reported; one that stays above ``clearance_m - tolerance_m / 2`` never
+    is (so parts resting on fixtures do not collide). ``allowed_pairs``: pairs of body names
+    never checked (robot links by link name, e.g. ``"link_3"``; the tool by its station name;
+    parts and fixtures by name). ``self_collision``: check the robot's bodies against each other.
+    ``tool_touches_parts``: the tool may touch and enter parts. ``home_contacts``: allow the
+    robot-side pairs already in contact at the home position. ``attachments``: parts carried by
+    the tool (pick and place). ``mode``: ``"advance"`` proves the path between samples free;
+    ``"samples"`` checks the resolve samples only (a reference that misses thin obstacles).
+    """
+
+    clearance_m: float = 0.0
+    tolerance_m: float = 1e-4
+    allowed_pairs: tuple[tuple[str, str], ...] = ()
+    self_collision: bool = True
+    tool_touches_parts: bool = True
+    home_contacts: bool = True
+    attachments: tuple[Attachment, ...] = ()
+    mode: Literal["advance", "samples"] = "advance"
+
+    def __post_init__(self) -> None:
+        if not self.tolerance_m > 0:
+            raise ValueError("CollisionOptions.tolerance_m must be positive")
+        if self.clearance_m < 0:
+            raise ValueError("CollisionOptions.clearance_m must not be negative")
+
+
+@dataclass(frozen=True, slots=True)
+class CollisionStats:
+    """What a check did: distance evaluations and path rows (for benchmarks)."""
+
+    evaluations: int = 0
+    rows: int = 0
+    pairs: int = 0
+
+
+def check_collisions(
+    compiled: CompiledProgram, options: CollisionOptions | None = None
+) -> list[Diagnostic]:
+    """Diagnostics for every collision along the motions of ``compiled`` (see the module text).
+
+    Motions the resolve pass could not resolve (no path) are skipped. Never raises on a bad
+    program; an unknown part in ``options.attachments`` is an error diagnostic.
+    """
+    return check_collisions_with_stats(compiled, options)[0]
+
+
+def check_collisions_with_stats(
+    compiled: CompiledProgram, options: CollisionOptions | None = None
+) -> tuple[list[Diagnostic], CollisionStats]:
+    """:func:`check_collisions` and what it cost."""
+    from olp.collision.scene import UnsupportedChain
+
+    opts = options or CollisionOptions()
+    try:
+        runs, setup = _runs(compiled, opts)
+    except UnsupportedChain as exc:
+        message = f"collisions not checked: {exc}"
+        return [Diagnostic("warning", "collision_unchecked", message)], CollisionStats()
+    found: list[_Found] = []
+    stats = CollisionStats()
+    for run in runs:
+        hits, run_stats = _check_run(run, opts)
+        found.extend(hits)
+        stats = CollisionStats(
+            stats.evaluations + run_stats.evaluations,
+            stats.rows + run_stats.rows,
+            max(stats.pairs, run_stats.pairs),
+        )
+    return _bodiless_tools(compiled) + setup + _diagnostics(found, opts.clearance_m), stats
+
+
+# --------------------------------------------------------------------------------------------
+# The program as runs of motions in one scene
+
+
+@dataclass(slots=True, eq=False)
+class _Run:
+    """Consecutive resolved motions (joined end to start) in one scene."""
+
+    scene: Scene
+    steps: list[Step] = field(default_factory=list)
+    ordinals: list[int] = field(default_factory=list)
+
+
+@dataclass(slots=True, eq=False)
+class _World:
+    """The state the scene depends on while walking the program."""
+
+    objects: dict[str, FloatArray]
+    carried: dict[str, FloatArray]
+    joints: FloatArray
+    pending: list[Attachment]
+    version: int = 0
+
+
+def _runs(compiled: CompiledProgram, opts: CollisionOptions) -> tuple[list[_Run], list[Diagnostic]]:
+    """The resolved motions in runs: a new run where a motion does not start where the previous
+    one ended, or where the tool or the carried parts change."""
+    station = compiled.station
+    known = {o.name for o in station.objects}
+    world = _World(
+        objects={o.name: o.pose for o in station.objects},
+        carried={},
+        joints=compiled.start_joints,
+        pending=[a for a in opts.attachments if a.part in known],
+    )
+    scenes: dict[tuple[object, ...], Scene] = {}
+    runs: list[_Run] = []
+    last = b""
+    motions = (s for s in compiled.steps if is_motion(s.instruction))
+    for ordinal, step in enumerate(motions):
+        changed = bool(world.pending) and _apply_attachments(step.index, world, station)
+        path = step.path
+        if path is None or len(path) < 2:
+            last = b""
+            continue
+        key = _scene_key(step, world)
+        scene = scenes.get(key)
+        if scene is None:
+            scene = scenes[key] = _scene(station, step, world, opts)
+        if changed or not runs or runs[-1].scene is not scene or path[0].tobytes() != last:
+            runs.append(_Run(scene))
+        runs[-1].steps.append(step)
+        runs[-1].ordinals.append(ordinal)
+        last = path[-1].tobytes()
+        world.joints = path[-1]
+    return runs, _unknown_parts(compiled, opts)
+
+
+def _unknown_parts(compiled: CompiledProgram, opts: CollisionOptions) -> list[Diagnostic]:
+    known = {o.name for o in compiled.station.objects}
+    out = []
+    for a in opts.attachments:
+        if a.part not in known:
+            step = next((s for s in compiled.steps if s.index == a.grasp), None)
+            span = step.instruction.span if step is not None else None
+            names = ", ".join(sorted(known)) or "none"
+            message = f"the tool cannot carry {a.part!r}: no such part in the station ({names})"
+            out.append(Diagnostic("error", "unknown_part", message, span, a.grasp))
+    return out
+
+
+def _apply_attachments(index: int, world: _World, station: Station) -> bool:
+    """Grip and let go of parts up to instruction ``index``; True if anything changed."""
+    changed = False
+    due = [a for a in world.pending if index >= a.grasp]
+    if not due:
+        return False
+    flange = station.robot.flange_poses(world.joints)
+    for a in due:
+        if a.part not in world.carried and a.part in world.objects:
+            world.carried[a.part] = inv(flange) @ world.objects.pop(a.part)
+            changed = True
+        if a.part in world.carried and a.release is not None and index >= a.release:
+            world.objects[a.part] = flange @ world.carried.pop(a.part)
+            world.pending.remove(a)
+            changed = True
+    world.version += changed
+    return changed
+
+
+def _scene_key(step: Step, world: _World) -> tuple[object, ...]:
+    tool = step.tool
+    return (None if tool is None else (tool.name, tool.number)), world.version
+
+
+def _tool_body(station: Station, tool: Tool | None) -> Placed | None:
+    """The station's body of a step's tool: by name, else the station tool of the same number
+    (an inline KRL tool), else none."""
+    from olp.collision.scene import Placed
+
+    if tool is None:
+        return None
+    name = _station_tool_name(station, tool)
+    body = station.tool_bodies.get(name)
+    return Placed(name, "tool", np.eye(4), body.shapes) if body is not None else None
+
+
+def _station_tool_name(station: Station, tool: Tool) -> str:
+    """The station tool a step's tool is: by name, by number, else the one with the same TCP
+    (an inline KRL ``$TOOL = {FRAME: ...}`` copied from the cell), else its own name."""
+    if tool.name in station.tool_bodies:
+        return tool.name
+    known = station.tool(Tool(name=tool.name, number=tool.number))
+    if known is not None:
+        return known.name
+    if tool.pose is not None:
+        for candidate in station.tools.values():
+            if candidate.pose is not None and np.allclose(candidate.pose, tool.pose, atol=1e-9):
+                return candidate.name
+    return tool.name
+
+
+def _bodiless_tools(compiled: CompiledProgram) -> list[Diagnostic]:
+    """A warning for each tool the program uses that has no collision geometry while the
+    station gives geometry to its tools: only the robot's links are checked for it."""
+    station = compiled.station
+    if not any(body.shapes for body in station.tool_bodies.values()):
+        return []
+    out, seen = [], {FLANGE.name}
+    for step in compiled.steps:
+        tool = step.tool
+        if tool is None or step.joints is None or tool.name in seen:
+            continue
+        seen.add(tool.name)
+        if _station_tool_name(station, tool) not in station.tool_bodies:
+            msg = (
+                f"tool {tool.name!r} has no collision geometry in the station (no tool of that "
+                "name, number or TCP): only the robot's links are checked while it is used"
+            )
+            span = step.instruction.span
+            out.append(Diagnostic("warning", "collision_unchecked", msg, span, step.index))
+    return out
+
+
+def _scene(station: Station, step: Step, world: _World, opts: CollisionOptions) -> Scene:
+    from olp.collision.scene import PairRules, Placed, build_scene
+
+    shapes = {o.name: o for o in station.objects}
+    tool = _tool_body(station, step.tool)
+    carried = [Placed(n, "carried", p, shapes[n].shapes) for n, p in sorted(world.carried.items())]
+    objects = [
+        Placed(n, shapes[n].kind, p, shapes[n].shapes) for n, p in sorted(world.objects.items())
+    ]
+    rules = PairRules(
+        allowed=frozenset(frozenset(p) for p in opts.allowed_pairs),
+        tool_touches_parts=opts.tool_touches_parts,
+        self_collision=opts.self_collision,
+        home_contacts=opts.home_contacts,
+        contact_below=opts.clearance_m - opts.tolerance_m / 2,
+    )
+    return build_scene(station.robot, tool, carried, objects, rules)
+
+
+# --------------------------------------------------------------------------------------------
+# Checking a run
+
+
+@dataclass(frozen=True, slots=True)
+class _Found:
+    """A hit located in the program."""
+
+    first: str
+    second: str
+    kind: str
+    ordinal: int
+    step: Step
+    hit: Hit
+
+
+def _check_run(run: _Run, opts: CollisionOptions) -> tuple[list[_Found], CollisionStats]:
+    from olp.collision.advance import advance, cumulative_bounds, path_run, sample_hits
+
+    scene = run.scene
+    path = path_run([s.path for s in run.steps if s.path is not None], scene.chain_joints)
+    lower = opts.clearance_m - opts.tolerance_m
+    upper = opts.clearance_m - opts.tolerance_m / 2
+    found: list[_Found] = []
+    evaluations = 0
+    if not scene.pairs:
+        return found, CollisionStats(0, len(path.joints), 0)
+    unique, inverse = np.unique([p.weights for p in scene.pairs], axis=0, return_inverse=True)
+    which = inverse.reshape(-1)
+    bounds = cumulative_bounds(path, unique) if opts.mode == "advance" else unique[:, :0]
+    for k, pair in enumerate(scene.pairs):
+        if opts.mode == "samples":
+            hits, count = sample_hits(scene, pair, path, upper)
+        else:
+            hits, count = advance(scene, pair, path, lower, upper, bounds[int(which[k])])
+        evaluations += count
+        first, second = scene.name_of(pair)
+        for hit in hits:
+            step, ordinal = run.steps[hit.motion], run.ordinals[hit.motion]
+            found.append(_Found(first, second, pair.kind, ordinal, step, hit))
+    return found, CollisionStats(evaluations, len(path.joints), len(scene.pairs))
+
+
+# --------------------------------------------------------------------------------------------
+# Diagnostics
+
+
+def _diagnostics(found: Sequence[_Found], clearance: float) -> list[Diagnostic]:
+    """One diagnostic per pair of bodies and run of consecutive colliding motions."""
+    groups: dict[tuple[str, str, str], list[_Found]] = {}
+    for f in sorted(found, key=lambda f: (f.first, f.second, f.ordinal)):
+        groups.setdefault((f.first, f.second, f.kind), []).append(f)
+    out = []
+    for items in groups.values():
+        start = 0
+        for k in range(1, len(items) + 1):
+            if k == len(items) or items[k].ordinal != items[k - 1].ordinal + 1:
+                out.append(_diagnostic(items[start:k], clearance))
+                start = k
+    return sorted(out, key=lambda d: (d.index if d.index is not None else -1, d.message))
+
+
+_HINTS = {
+    "collision": "add a via point or change the approach so the path goes around the obstacle, "
+    "or move the obstacle",
+    "self_collision": "use another robot configuration (IK branch) or add a via point",
+}
+
+
+def _diagnostic(items: Sequence[_Found], clearance: float) -> Diagnostic:
+    first = items[0]
+    hit = first.hit
+    what = "self-collision: " if first.kind == "self_collision" else ""
+    pair = f"{what}{first.first} hits {first.second}"
+    near = f" (closer than {clearance * 1000:.1f} mm)" if hit.distance >= 0 else ""
+    text = f"{pair} at {hit.fraction:.0%} of the move{near}"
+    if len(items) > 1:
+        text = (
+            f"moves {first.step.index}-{items[-1].step.index}: {pair}{near} "
+            f"(first at {hit.fraction:.0%} of move {first.step.index})"
+        )
+    return Diagnostic(
+        "error",
+        first.kind,
+        text,
+        first.step.instruction.span,
+        first.step.index,
+        joints=hit.joints,
+        hint=_HINTS[first.kind],
+    )
