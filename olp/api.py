@@ -211,10 +211,9 @@ def build(
     diagnostics = notes + compiled.diagnostics
     if not compiled.ok:
         return BuildResult(compiled, manifest.name, diagnostics)
-    from importlib import import_module
+    from olp.post import post_diagnostics
 
-    vendor = import_module(f"olp.vendors.{manifest.vendor}") if manifest.vendor else None
-    extra: builtins.list[Diagnostic] = getattr(vendor, "post_diagnostics", lambda _c: [])(compiled)
+    extra = post_diagnostics(compiled, manifest)
     diagnostics = diagnostics + tuple(extra)
     if has_errors(diagnostics):
         return BuildResult(compiled, manifest.name, diagnostics)

@@ -3,26 +3,83 @@
 A post folder holds ``post.yaml`` (the manifest) and Jinja2 templates. The manifest says::
 
     name: kuka
-    vendor: kuka                      # olp.vendors.<vendor> supplies filters and name rules
-    description: ...
+    vendor: kuka                      # olp.vendors.<vendor>: filters, name rules, hooks
+    description: ...                  # one line for `olp posts`
     line_ending: "\\r\\n"
     encoding: ascii                   # text that cannot be encoded is an error, never mangled
-    files:                            # one entry per output file
+    files:                            # one entry per output file of a program (or of a part)
       - {template: program.src.j2, name: "{name}.src"}
-    options: {...}                    # free-form, passed to templates as `options`
+    main_files:                       # a split program's main program (calls the parts)
+      - {template: main.src.j2, name: "{name}.src"}
+    limits:                           # per file; omitted or null: no limit
+      max_motions_per_file: 2000      # positions
+      max_instructions_per_file: null # instructions of any kind
+      max_lines_per_file: null        # text lines, checked on the rendered files
+    frames_in: world                  # or robot_base: the controller's reference for frames
+    options: {...}                    # free-form: templates see them as `options`, vendor
+                                      # hooks get them too
 
-Templates see ``program`` (name, source), ``steps`` (see :class:`PostStep`), ``station``,
-``options`` and the vendor's filters (``olp.vendors.<vendor>.TEMPLATE_FILTERS``) plus ``num``.
-Output never depends on the locale (Python's ``format`` is locale-independent) and every file is
-written atomically (temporary file, then rename) only after all of them rendered.
+Splitting (:mod:`olp.transforms.split`): when ``limits`` are exceeded, the program becomes parts
+``<name>_P1`` ... rendered with ``files`` each, and a main program rendered with ``main_files``
+that calls them in order. Posts with ``limits`` must have ``main_files``.
+
+Template context (every file)
+-----------------------------
+``program``
+    ``name`` (legal name of this file's program: the whole program, a part, or the main),
+    ``source`` (where the program came from), ``main`` (the main program's name).
+``split``
+    True when the program was split (in parts and in the main).
+``unit``
+    ``name``, ``routine`` (the name of the routine to define: for the whole program or the main
+    the option ``entry``, default the program's name; for a part the option ``part_routine``,
+    a pattern like ``"{name}_run"``, default the part's name), ``index`` (0 for the whole
+    program or the main, k for part k), ``count`` (number of parts, 0 when not split),
+    ``is_part``, ``is_main`` (the whole program or the main).
+``parts``
+    In ``main_files``: the parts in call order, each ``{name, index, routine}``; else empty.
+``steps``
+    This file's instructions (:class:`PostStep`); empty in ``main_files``.
+``tools`` / ``frames``
+    The tools and frames this file's motions use (the main: all of the program's), each a
+    :class:`PostTool` / :class:`PostFrame` with a legal unique name.
+``vendor``
+    What the vendor module's ``context_values`` hook returns for this file (e.g. ABB's custom
+    speed and zone data); empty without the hook.
+``modal``
+    A :class:`Modal` change tracker for modal controller state: ``modal.changed("cdis", v)``.
+    Fresh for every file.
+``station``, ``robot`` (``station.robot``), ``options``, ``post`` (``name``, ``vendor``).
+
+Filters: ``num`` (:func:`num`), ``deg`` (radians to degrees), ``basename`` (:func:`basename`) and
+the vendor's ``TEMPLATE_FILTERS``.
+
+Vendor hooks (all optional, in ``olp.vendors.<vendor>``)
+--------------------------------------------------------
+* ``legal_name(str) -> str`` and ``MAX_NAME_LENGTH``: names of programs, parts, data.
+* ``PREDEFINED_NAMES``: names the controller already defines (never given to generated data).
+* ``NULL_TOOL_NAME`` / ``NULL_FRAME_NAME``: the controller's own name for no tool / the world
+  frame (ABB ``tool0`` / ``wobj0``), used for :data:`olp.ir.FLANGE` / :data:`olp.ir.WORLD`.
+* ``step_values(robot, joints, options) -> list[dict]``: per motion, from its planned joints
+  ``(N, dof)`` rad, vendor values such as KUKA Status/Turn or ABB confdata
+  (:attr:`PostStep.vendor`). Raising TypeError or ValueError becomes a :class:`PostError`.
+* ``context_values(steps, options) -> dict``: per file (the ``vendor`` context entry).
+* ``post_diagnostics(compiled, options) -> list[Diagnostic]``: what the post cannot say
+  exactly (see :func:`post_diagnostics`).
+
+Output never depends on the locale (Python's ``format`` is locale-independent), nor on hash
+seeds (no set iteration reaches the text), and every file is written atomically (temporary
+file, then rename) only after all of them rendered.
 """
 
 from __future__ import annotations
 
 import importlib
+import inspect
+import math
 import os
 import tempfile
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -30,13 +87,28 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from olp.diagnostics import Diagnostic
 from olp.errors import PostError, UsageError
 from olp.geometry import inv
-from olp.ir import MOTION_TYPES, CartesianTarget, Frame, JointMove, LinearMove, Tool
+from olp.ir import (
+    FLANGE,
+    MOTION_TYPES,
+    CartesianTarget,
+    CircularMove,
+    Frame,
+    JointMove,
+    Tool,
+)
 from olp.passes.resolve import CompiledProgram, Step
 from olp.resources import data_path
+from olp.transforms.split import LIMIT_KEYS, SplitLimits, part_names, split_steps
 
 FloatArray = NDArray[np.float64]
+
+FRAMES_IN = ("world", "robot_base")
+"""What frame poses are written relative to: the station's world (the controller's world frame
+must then be the station's) or the robot's controller base (``robot.base @
+robot.controller_base``; a controller whose world is its robot base, as delivered)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -51,6 +123,9 @@ class PostManifest:
     line_ending: str = "\n"
     encoding: str = "ascii"
     options: Mapping[str, Any] = field(default_factory=dict)
+    main_files: tuple[tuple[str, str], ...] = ()
+    limits: SplitLimits = field(default_factory=SplitLimits)
+    frames_in: str = "world"
 
 
 def available_posts() -> dict[str, Path]:
@@ -91,23 +166,54 @@ def load_manifest(folder: Path) -> PostManifest:
         raise PostError(f"cannot read post manifest {path}: {exc}") from exc
     if not isinstance(raw, dict) or not isinstance(raw.get("files"), list):
         raise PostError(f"{path}: expected a mapping with a 'files' list")
+    limits = _limits(raw.get("limits"), path)
+    main_files = _file_entries(raw.get("main_files") or [], folder, path)
+    if limits.active and not main_files:
+        raise PostError(f"{path}: 'limits' need 'main_files' (the main program of the parts)")
+    frames_in = str(raw.get("frames_in", "world"))
+    if frames_in not in FRAMES_IN:
+        raise PostError(f"{path}: frames_in must be one of {', '.join(FRAMES_IN)}")
+    return PostManifest(
+        name=str(raw.get("name", folder.name)),
+        vendor=str(raw.get("vendor", "")),
+        folder=folder,
+        files=_file_entries(raw["files"], folder, path),
+        description=str(raw.get("description", "")),
+        line_ending=str(raw.get("line_ending", "\n")),
+        encoding=str(raw.get("encoding", "ascii")),
+        options=dict(raw.get("options") or {}),
+        main_files=main_files,
+        limits=limits,
+        frames_in=frames_in,
+    )
+
+
+def _file_entries(entries: Any, folder: Path, path: Path) -> tuple[tuple[str, str], ...]:
+    if not isinstance(entries, list):
+        raise PostError(f"{path}: expected a list of files, got {entries!r}")
     files = []
-    for entry in raw["files"]:
+    for entry in entries:
         if not isinstance(entry, dict) or "template" not in entry or "name" not in entry:
             raise PostError(f"{path}: each file needs 'template' and 'name', got {entry!r}")
         if not (folder / entry["template"]).is_file():
             raise PostError(f"{path}: template {entry['template']!r} not found in {folder}")
         files.append((str(entry["template"]), str(entry["name"])))
-    return PostManifest(
-        name=str(raw.get("name", folder.name)),
-        vendor=str(raw.get("vendor", "")),
-        folder=folder,
-        files=tuple(files),
-        description=str(raw.get("description", "")),
-        line_ending=str(raw.get("line_ending", "\n")),
-        encoding=str(raw.get("encoding", "ascii")),
-        options=dict(raw.get("options") or {}),
-    )
+    return tuple(files)
+
+
+def _limits(raw: Any, path: Path) -> SplitLimits:
+    if raw is None:
+        return SplitLimits()
+    if not isinstance(raw, dict) or set(raw) - set(LIMIT_KEYS):
+        raise PostError(f"{path}: 'limits' takes only {', '.join(LIMIT_KEYS)}, got {raw!r}")
+    try:
+        return SplitLimits(
+            raw.get("max_motions_per_file"),
+            raw.get("max_instructions_per_file"),
+            raw.get("max_lines_per_file"),
+        )
+    except ValueError as exc:
+        raise PostError(f"{path}: limits: {exc}") from exc
 
 
 # --------------------------------------------------------------------------------------------
@@ -115,13 +221,71 @@ def load_manifest(folder: Path) -> PostManifest:
 
 
 @dataclass(frozen=True, slots=True, eq=False)
+class PostTool:
+    """A tool as the output names it: ``name`` (legal, unique in the program), ``tool`` (the
+    resolved tool; its ``pose`` is the TCP in the vendor's flange frame, (4, 4) m), ``number``
+    (the station's number or None), ``mass`` (kg from the station, None when unknown), ``null``
+    (it is the bare flange)."""
+
+    name: str
+    tool: Tool
+    number: int | None
+    mass: float | None
+    null: bool = False
+
+    @property
+    def pose(self) -> FloatArray:
+        assert self.tool.pose is not None
+        return self.tool.pose
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class PostFrame:
+    """A frame as the output names it: ``name`` (legal, unique in the program), ``frame`` (the
+    resolved frame, pose in the station's world), ``number`` (the station's number or None),
+    ``pose`` ((4, 4) m, relative to the manifest's ``frames_in`` reference: what the controller
+    is told), ``null`` (it is the reference itself: the world, or the robot base)."""
+
+    name: str
+    frame: Frame
+    number: int | None
+    pose: FloatArray
+    null: bool = False
+
+
+@dataclass(frozen=True, slots=True, eq=False)
 class PostStep:
     """What a template sees for one instruction.
 
-    For motions: ``joints`` (rad, controller convention), ``pose`` (TCP in the motion's frame,
-    (4, 4) m), ``cartesian`` (the source gave a Cartesian target), and change flags that say
-    where a vendor with modal state must emit an assignment (``new_tool``, ``new_frame``,
-    ``new_linear_speed``, ``new_joint_speed``, ``new_zone``).
+    Every instruction: ``index`` (in the program), ``kind`` (``joint``, ``linear``,
+    ``circular``, ``wait``, ``set_output``, ``wait_input``, ``call``, ``comment``), ``source``
+    (``file:line``), ``instruction`` (the IR object).
+
+    Motions:
+
+    * ``joints``: planned joints at the end, (dof,) rad, controller convention.
+    * ``pose``: the TCP in the motion's frame, (4, 4) m (the target itself for a Cartesian
+      target; from the planned joints otherwise).
+    * ``tool`` / ``frame``: the resolved :class:`olp.ir.Tool` / :class:`olp.ir.Frame`.
+    * ``cartesian``: the source gave a Cartesian target.
+    * ``new_tool``, ``new_frame``, ``new_linear_speed``, ``new_joint_speed``, ``new_zone``:
+      the value differs from the previous motion's *in this file* (each file starts afresh, so
+      a part never relies on state set by another).
+    * ``motion`` (added): 1-based number of the motion in the whole program.
+    * ``name`` (added): a legal identifier for the target, unique in the program (the manifest
+      option ``point_names``, default ``"P{n}"``, with ``n`` = ``motion``).
+    * ``via`` / ``via_name`` (added): a circular move's auxiliary point, (4, 4) m in the frame,
+      and its identifier (option ``via_names``, default ``"V{n}"``).
+    * ``tool_name`` / ``frame_name`` (added): the names of this motion's :class:`PostTool` /
+      :class:`PostFrame` (see the ``tools`` / ``frames`` context entries).
+    * ``frame_pose`` (added): the frame as the controller is told, (4, 4) m relative to the
+      manifest's ``frames_in`` reference; ``base_pose`` (added): the TCP in that reference,
+      ``frame_pose @ pose``.
+    * ``duration`` (added): seconds, from the timing pass (0 when it did not run).
+    * ``vendor`` (added): per-motion vendor values from the vendor module's ``step_values``
+      (KUKA ``status``, ``turn``; ABB ``confdata``), empty without the hook.
+
+    Properties ``speed`` and ``zone`` are the instruction's.
     """
 
     index: int
@@ -138,6 +302,16 @@ class PostStep:
     new_linear_speed: bool = False
     new_joint_speed: bool = False
     new_zone: bool = False
+    motion: int = 0
+    name: str = ""
+    via: FloatArray | None = None
+    via_name: str = ""
+    tool_name: str = ""
+    frame_name: str = ""
+    frame_pose: FloatArray | None = None
+    base_pose: FloatArray | None = None
+    duration: float = 0.0
+    vendor: Mapping[str, Any] = field(default_factory=dict)
 
     @property
     def speed(self) -> Any:
@@ -148,50 +322,221 @@ class PostStep:
         return self.instruction.zone
 
 
+class Modal:
+    """Tracks modal controller state while a template is rendered.
+
+    ``changed(key, value)`` is True when ``value`` differs from the last value recorded under
+    ``key`` (or none was), and records it. Arrays compare by value, tools and frames by name
+    and pose.
+    """
+
+    def __init__(self) -> None:
+        self._last: dict[str, Any] = {}
+
+    def changed(self, key: str, value: Any) -> bool:
+        return _changed(self._last, key, value)
+
+    def forget(self, key: str) -> str:
+        """Drop ``key`` (e.g. after a call that may change the state); renders as ''."""
+        self._last.pop(key, None)
+        return ""
+
+
 def build_steps(compiled: CompiledProgram) -> list[PostStep]:
-    """The template view of every compiled instruction, with modal-state change flags."""
-    robot = compiled.station.robot
-    out: list[PostStep] = []
-    last: dict[str, Any] = {}
-    for step in compiled.steps:
-        ins = step.instruction
-        source = ins.span.location
-        if not isinstance(ins, MOTION_TYPES):
-            out.append(PostStep(step.index, ins.kind, source, ins))
-            continue
-        if step.skipped:
-            continue
-        assert step.joints is not None and step.tool is not None and step.frame is not None
-        pose = _pose_in_frame(step, robot.flange_poses(step.joints))
+    """The template view of every compiled instruction as one file (generic names, no vendor
+    values), with modal-state change flags."""
+    view = _ProgramView(compiled, None, PostManifest("", "", Path("."), ()))
+    names = _Names(str, None, ())
+    return view.unit_steps(compiled.steps, view.allocate(names))
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class _Motion:
+    """Per-motion data computed once per render (not per file)."""
+
+    pose: FloatArray
+    frame_pose: FloatArray
+    via: FloatArray | None
+    vendor: Mapping[str, Any]
+    number: int
+
+
+@dataclass(frozen=True, slots=True)
+class _Allocation:
+    """Names given to one program's points, tools and frames."""
+
+    points: Mapping[int, tuple[str, str]]
+    tools: Mapping[int, PostTool]
+    frames: Mapping[int, PostFrame]
+
+
+class _ProgramView:
+    """Everything the templates see that does not depend on how the program is split."""
+
+    def __init__(self, compiled: CompiledProgram, vendor: Any, manifest: PostManifest) -> None:
+        self.compiled = compiled
+        self.vendor = vendor
+        self.manifest = manifest
+        robot = compiled.station.robot
+        self.reference = (
+            robot.base @ robot.controller_base if manifest.frames_in == "robot_base" else np.eye(4)
+        )
+        self.motions = self._motions()
+
+    def _motions(self) -> dict[int, _Motion]:
+        written = [s for s in self.compiled.steps if _written_motion(s)]
+        if not written:
+            return {}
+        robot = self.compiled.station.robot
+        joints = np.stack([np.asarray(s.joints, dtype=np.float64) for s in written])
+        flanges = robot.flange_poses(joints)
+        values = self._vendor_values(joints)
+        ref_inv = inv(self.reference)
+        out = {}
+        for n, (step, flange, vendor) in enumerate(zip(written, flanges, values, strict=True)):
+            assert step.frame is not None and step.frame.pose is not None
+            out[step.index] = _Motion(
+                pose=_pose_in_frame(step, flange),
+                frame_pose=ref_inv @ step.frame.pose,
+                via=_via(step),
+                vendor=vendor,
+                number=n + 1,
+            )
+        return out
+
+    def _vendor_values(self, joints: FloatArray) -> list[Mapping[str, Any]]:
+        hook = getattr(self.vendor, "step_values", None)
+        if hook is None:
+            return [{} for _ in range(joints.shape[0])]
+        try:
+            values: list[Mapping[str, Any]] = hook(
+                self.compiled.station.robot, joints, self.manifest.options
+            )
+        except (TypeError, ValueError) as exc:
+            raise PostError(
+                f"post {self.manifest.name!r} cannot describe robot "
+                f"{self.compiled.station.robot.name!r}: {exc}"
+            ) from exc
+        return values
+
+    def allocate(self, names: _Names) -> _Allocation:
+        """Give every point, tool and frame of the program a name."""
+        options = self.manifest.options
+        point_pattern = str(options.get("point_names", "P{n}"))
+        via_pattern = str(options.get("via_names", "V{n}"))
+        points: dict[int, tuple[str, str]] = {}
+        tools: dict[int, PostTool] = {}
+        frames: dict[int, PostFrame] = {}
+        tool_keys: dict[tuple[str, bytes], PostTool] = {}
+        frame_keys: dict[tuple[str, bytes], PostFrame] = {}
+        for step in self.compiled.steps:
+            motion = self.motions.get(step.index)
+            if motion is None:
+                continue
+            via = names.take(via_pattern.format(n=motion.number)) if motion.via is not None else ""
+            points[step.index] = (names.take(point_pattern.format(n=motion.number)), via)
+            assert step.tool is not None and step.frame is not None
+            tools[step.index] = self._tool(step.tool, tool_keys, names)
+            frames[step.index] = self._frame(step.frame, motion.frame_pose, frame_keys, names)
+        return _Allocation(points, tools, frames)
+
+    def _tool(self, tool: Tool, seen: dict[tuple[str, bytes], PostTool], names: _Names) -> PostTool:
+        assert tool.pose is not None
+        key = (tool.name, np.asarray(tool.pose).tobytes())
+        if key not in seen:
+            null = _is_null(tool, FLANGE)
+            special = getattr(self.vendor, "NULL_TOOL_NAME", None) if null else None
+            body = self.compiled.station.tool_bodies.get(tool.name)
+            seen[key] = PostTool(
+                special or names.take(tool.name),
+                tool,
+                tool.number,
+                None if body is None else body.mass,
+                null,
+            )
+        return seen[key]
+
+    def _frame(
+        self,
+        frame: Frame,
+        pose: FloatArray,
+        seen: dict[tuple[str, bytes], PostFrame],
+        names: _Names,
+    ) -> PostFrame:
+        assert frame.pose is not None
+        key = (frame.name, np.asarray(frame.pose).tobytes())
+        if key not in seen:
+            null = bool(np.allclose(pose, np.eye(4), rtol=0.0, atol=1e-12))
+            special = getattr(self.vendor, "NULL_FRAME_NAME", None) if null else None
+            seen[key] = PostFrame(
+                special or names.take(frame.name), frame, frame.number, pose, null
+            )
+        return seen[key]
+
+    def unit_steps(self, steps: Sequence[Step], names: _Allocation) -> list[PostStep]:
+        """The template view of ``steps`` as one file: change flags start afresh."""
+        out: list[PostStep] = []
+        last: dict[str, Any] = {}
+        for step in steps:
+            ins = step.instruction
+            if not isinstance(ins, MOTION_TYPES):
+                out.append(PostStep(step.index, ins.kind, ins.span.location, ins))
+            elif step.index in self.motions:
+                out.append(self._motion_step(step, names, last))
+        return out
+
+    def _motion_step(self, step: Step, names: _Allocation, last: dict[str, Any]) -> PostStep:
+        ins: Any = step.instruction
+        motion = self.motions[step.index]
         flags = {
             "new_tool": _changed(last, "tool", step.tool),
             "new_frame": _changed(last, "frame", step.frame),
             "new_zone": _changed(last, "zone", ins.zone),
         }
         if isinstance(ins, JointMove):
-            flags["new_joint_speed"] = _changed(
-                last, "joint_speed", (ins.speed.joint, ins.speed.joint_acceleration)
-            )
+            speed = (ins.speed.joint, ins.speed.joint_acceleration)
+            flags["new_joint_speed"] = _changed(last, "joint_speed", speed)
         else:
-            flags["new_linear_speed"] = _changed(
-                last, "linear_speed", (ins.speed.linear, ins.speed.angular)
-            )
-        cartesian = isinstance(ins.target, CartesianTarget)
-        out.append(
-            PostStep(
-                step.index,
-                ins.kind,
-                source,
-                ins,
-                step.joints,
-                pose,
-                step.tool,
-                step.frame,
-                cartesian,
-                **flags,
-            )
+            speed = (ins.speed.linear, ins.speed.angular)
+            flags["new_linear_speed"] = _changed(last, "linear_speed", speed)
+        point, via = names.points[step.index]
+        return PostStep(
+            step.index,
+            ins.kind,
+            ins.span.location,
+            ins,
+            joints=step.joints,
+            pose=motion.pose,
+            tool=step.tool,
+            frame=step.frame,
+            cartesian=isinstance(ins.target, CartesianTarget),
+            motion=motion.number,
+            name=point,
+            via=motion.via,
+            via_name=via,
+            tool_name=names.tools[step.index].name,
+            frame_name=names.frames[step.index].name,
+            frame_pose=motion.frame_pose,
+            base_pose=motion.frame_pose @ motion.pose,
+            duration=step.duration,
+            vendor=motion.vendor,
+            **flags,
         )
-    return out
+
+
+def _written_motion(step: Step) -> bool:
+    motion = isinstance(step.instruction, MOTION_TYPES)
+    return motion and not step.skipped and step.joints is not None
+
+
+def _is_null(obj: Tool | Frame, null: Tool | Frame) -> bool:
+    assert obj.pose is not None
+    return obj.name == null.name and bool(np.array_equal(obj.pose, np.eye(4)))
+
+
+def _via(step: Step) -> FloatArray | None:
+    ins = step.instruction
+    return np.array(ins.via.pose) if isinstance(ins, CircularMove) else None
 
 
 def _changed(last: dict[str, Any], key: str, value: Any) -> bool:
@@ -203,17 +548,40 @@ def _changed(last: dict[str, Any], key: str, value: Any) -> bool:
 def _same(a: Any, b: Any) -> bool:
     if hasattr(a, "pose") and hasattr(b, "pose"):
         return bool(a.name == b.name and np.array_equal(a.pose, b.pose))
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        return bool(np.array_equal(a, b))
     return bool(a == b)
 
 
 def _pose_in_frame(step: Step, flange: FloatArray) -> FloatArray:
     ins = step.instruction
-    if isinstance(ins, JointMove | LinearMove) and isinstance(ins.target, CartesianTarget):
+    if isinstance(ins, MOTION_TYPES) and isinstance(ins.target, CartesianTarget):
         return np.array(ins.target.pose)
     assert step.tool is not None and step.frame is not None
     assert step.tool.pose is not None and step.frame.pose is not None
     result: FloatArray = inv(step.frame.pose) @ flange @ step.tool.pose
     return result
+
+
+class _Names:
+    """Identifiers that are legal for the vendor and unique ignoring case."""
+
+    def __init__(
+        self, legal: Callable[[str], str], max_length: int | None, reserved: Sequence[str]
+    ) -> None:
+        self.legal = legal
+        self.max_length = max_length
+        self.taken = {r.casefold() for r in reserved}
+
+    def take(self, wanted: str) -> str:
+        base = self.legal(wanted)
+        name, k = base, 2
+        while name.casefold() in self.taken:
+            suffix = f"_{k}"
+            cut = base if self.max_length is None else base[: self.max_length - len(suffix)]
+            name, k = self.legal(cut + suffix), k + 1
+        self.taken.add(name.casefold())
+        return name
 
 
 # --------------------------------------------------------------------------------------------
@@ -228,41 +596,208 @@ def num(value: float, decimals: int = 3) -> str:
     return text
 
 
+def basename(path: str) -> str:
+    """The last component of a path written with ``/`` or ``\\`` (for header comments: where a
+    program came from, without the machine's folders)."""
+    return str(path).replace("\\", "/").rstrip("/").rsplit("/", 1)[-1]
+
+
+_MAX_SPLIT_ROUNDS = 12
+"""How often :func:`render` splits finer to meet ``max_lines_per_file`` before it gives up."""
+
+
 def render(
     compiled: CompiledProgram, manifest: PostManifest, name: str | None = None
 ) -> dict[str, str]:
-    """Render every file of the post: ``{file name: text}``. Raises PostError, writes nothing."""
-    import jinja2
+    """Render every file of the post: ``{file name: text}``. Raises PostError, writes nothing.
 
-    vendor = _vendor_module(manifest)
-    legal = getattr(vendor, "legal_name", lambda s: s)
-    program_name = legal(name or compiled.program.name)
-    env = jinja2.Environment(
-        loader=jinja2.FileSystemLoader(str(manifest.folder)),
-        undefined=jinja2.StrictUndefined,
-        keep_trailing_newline=True,
-        trim_blocks=True,
-        lstrip_blocks=True,
-        autoescape=False,
-    )
-    filters: Mapping[str, Callable[..., Any]] = getattr(vendor, "TEMPLATE_FILTERS", {})
-    env.filters.update({"num": num, **filters})
-    context = {
-        "program": {"name": program_name, "source": compiled.program.source},
-        "steps": build_steps(compiled),
-        "station": compiled.station,
-        "options": manifest.options,
-        "post": {"name": manifest.name, "vendor": manifest.vendor},
-    }
-    files: dict[str, str] = {}
-    for template, pattern in manifest.files:
-        try:
-            text = env.get_template(template).render(**context)
-        except jinja2.TemplateError as exc:
-            where = f"{manifest.folder / template}:{getattr(exc, 'lineno', '?')}"
-            raise PostError(f"{where}: template error: {exc}") from exc
-        files[pattern.format(name=program_name)] = _line_endings(text, manifest.line_ending)
-    return files
+    Splits the program into parts when the manifest's ``limits`` ask for it (splitting finer
+    until every file has at most ``max_lines_per_file`` lines).
+    """
+    renderer = _Renderer(compiled, manifest, name)
+    limits = manifest.limits
+    for _ in range(_MAX_SPLIT_ROUNDS):
+        parts = split_steps(compiled.steps, limits)
+        files = renderer.render(parts)
+        longest, lines = _longest(files, manifest.line_ending)
+        if manifest.limits.max_lines is None or lines <= manifest.limits.max_lines:
+            return files
+        limits = _finer(limits, parts, lines, manifest.limits.max_lines, longest, renderer)
+    raise PostError(f"post {manifest.name!r}: could not meet max_lines_per_file by splitting")
+
+
+def _longest(files: Mapping[str, str], ending: str) -> tuple[str, int]:
+    counts = {f: text.count(ending) + (not text.endswith(ending)) for f, text in files.items()}
+    fname = max(counts, key=lambda f: (counts[f], f))
+    return fname, counts[fname]
+
+
+def _finer(
+    limits: SplitLimits,
+    parts: list[tuple[Step, ...]],
+    lines: int,
+    max_lines: int,
+    longest: str,
+    renderer: _Renderer,
+) -> SplitLimits:
+    """Tighter instruction limits after a file came out with ``lines`` > ``max_lines``."""
+    biggest = max(sum(1 for s in p if not s.skipped) for p in parts)
+    if longest in renderer.main_file_names or biggest <= 1:
+        raise PostError(
+            f"post {renderer.manifest.name!r}: {longest} has {lines} lines, more than "
+            f"max_lines_per_file {max_lines}, and splitting cannot make it shorter"
+        )
+    fewer = max(1, min(biggest - 1, math.floor(biggest * max_lines / lines)))
+    return SplitLimits(limits.max_motions, fewer, limits.max_lines)
+
+
+class _Renderer:
+    """Renders one compiled program through one post, for a given split."""
+
+    def __init__(self, compiled: CompiledProgram, manifest: PostManifest, name: str | None):
+        import jinja2
+
+        self.compiled = compiled
+        self.manifest = manifest
+        self.vendor = _vendor_module(manifest)
+        self.legal: Callable[[str], str] = getattr(self.vendor, "legal_name", lambda s: s)
+        self.max_length: int | None = getattr(self.vendor, "MAX_NAME_LENGTH", None)
+        self.name = self.legal(name or compiled.program.name)
+        self.view = _ProgramView(compiled, self.vendor, manifest)
+        self.env = jinja2.Environment(
+            loader=jinja2.FileSystemLoader(str(manifest.folder)),
+            undefined=jinja2.StrictUndefined,
+            keep_trailing_newline=True,
+            trim_blocks=True,
+            lstrip_blocks=True,
+            autoescape=False,
+        )
+        filters: Mapping[str, Callable[..., Any]] = getattr(self.vendor, "TEMPLATE_FILTERS", {})
+        self.env.filters.update({"num": num, "deg": math.degrees, "basename": basename, **filters})
+        self.main_file_names: set[str] = set()
+
+    def render(self, parts: list[tuple[Step, ...]]) -> dict[str, str]:
+        split = len(parts) > 1
+        unit_names = part_names(self.name, len(parts), self.legal, self.max_length) if split else []
+        names = _Names(
+            self.legal,
+            self.max_length,
+            [self.name, *unit_names, *getattr(self.vendor, "PREDEFINED_NAMES", ())],
+        )
+        options = self.manifest.options
+        entry = names.take(str(options["entry"])) if "entry" in options else self.name
+        routines = [
+            names.take(str(options.get("part_routine", "{name}")).format(name=n))
+            if "part_routine" in options
+            else n
+            for n in unit_names
+        ]
+        allocation = self.view.allocate(names)
+        if not split:
+            return self._files(self.manifest.files, self._unit(parts[0], allocation, 0, 0, entry))
+        main = self._unit((), allocation, 0, len(parts), entry)
+        main["parts"] = [
+            {"name": n, "index": k + 1, "routine": r}
+            for k, (n, r) in enumerate(zip(unit_names, routines, strict=True))
+        ]
+        main["tools"], main["frames"] = _used(allocation, [s.index for s in self.compiled.steps])
+        main_files = self._files(self.manifest.main_files, main)
+        self.main_file_names = set(main_files)
+        files: dict[str, str] = {}
+        for k, (steps, unit_name) in enumerate(zip(parts, unit_names, strict=True)):
+            unit = self._unit(steps, allocation, k + 1, len(parts), routines[k], unit_name)
+            files.update(self._files(self.manifest.files, unit, clash=files.keys() | main_files))
+        return {**main_files, **files}
+
+    def _unit(
+        self,
+        steps: Sequence[Step],
+        allocation: _Allocation,
+        index: int,
+        count: int,
+        routine: str,
+        unit_name: str | None = None,
+    ) -> dict[str, Any]:
+        view = self.view.unit_steps(steps, allocation)
+        tools, frames = _used(allocation, [s.index for s in view])
+        name = unit_name or self.name
+        return {
+            "program": {"name": name, "source": self.compiled.program.source, "main": self.name},
+            "split": count > 0,
+            "unit": {
+                "name": name,
+                "routine": routine,
+                "index": index,
+                "count": count,
+                "is_part": index > 0,
+                "is_main": index == 0,
+            },
+            "parts": [],
+            "steps": view,
+            "tools": tools,
+            "frames": frames,
+            "vendor": self._context_values(view),
+            "station": self.compiled.station,
+            "robot": self.compiled.station.robot,
+            "options": self.manifest.options,
+            "post": {"name": self.manifest.name, "vendor": self.manifest.vendor},
+        }
+
+    def _context_values(self, steps: list[PostStep]) -> Mapping[str, Any]:
+        hook = getattr(self.vendor, "context_values", None)
+        if hook is None:
+            return {}
+        values: Mapping[str, Any] = hook(steps, self.manifest.options)
+        return values
+
+    def _files(
+        self,
+        entries: Sequence[tuple[str, str]],
+        context: dict[str, Any],
+        clash: Any = frozenset(),
+    ) -> dict[str, str]:
+        import jinja2
+
+        files: dict[str, str] = {}
+        for template, pattern in entries:
+            context["modal"] = Modal()
+            try:
+                text = self.env.get_template(template).render(**context)
+            except jinja2.TemplateError as exc:
+                path = self.manifest.folder / template
+                raise PostError(
+                    f"{path}:{_template_line(exc, path)}: template error: {exc}"
+                ) from exc
+            fname = pattern.format(name=context["program"]["name"])
+            if fname in files or fname in clash:
+                raise PostError(f"post {self.manifest.name!r} writes {fname} twice")
+            files[fname] = _line_endings(text, self.manifest.line_ending)
+        return files
+
+
+def _template_line(exc: Exception, path: Path) -> int | str:
+    """The template line an error came from: syntax errors carry it; for runtime errors Jinja
+    rewrites the traceback so that a frame points into the template file."""
+    line = getattr(exc, "lineno", None)
+    tb = exc.__traceback__
+    while tb is not None:
+        if Path(tb.tb_frame.f_code.co_filename) == path:
+            line = tb.tb_lineno
+        tb = tb.tb_next
+    return line if line is not None else "?"
+
+
+def _used(
+    allocation: _Allocation, indices: Sequence[int]
+) -> tuple[list[PostTool], list[PostFrame]]:
+    """The distinct tools and frames of the motions at ``indices``, in order of first use."""
+    tools: dict[str, PostTool] = {}
+    frames: dict[str, PostFrame] = {}
+    for i in indices:
+        if i in allocation.tools:
+            tools.setdefault(allocation.tools[i].name, allocation.tools[i])
+            frames.setdefault(allocation.frames[i].name, allocation.frames[i])
+    return list(tools.values()), list(frames.values())
 
 
 def _vendor_module(manifest: PostManifest) -> Any:
@@ -279,9 +814,24 @@ def _line_endings(text: str, ending: str) -> str:
     return ending.join(line.rstrip() for line in lines)
 
 
+def post_diagnostics(compiled: CompiledProgram, manifest: PostManifest) -> list[Diagnostic]:
+    """What this post cannot say exactly about ``compiled``: the vendor module's
+    ``post_diagnostics(compiled, options)`` (older hooks take ``compiled`` only). Errors among
+    them mean nothing may be written."""
+    hook = getattr(_vendor_module(manifest), "post_diagnostics", None)
+    if hook is None:
+        return []
+    if len(inspect.signature(hook).parameters) >= 2:
+        found: list[Diagnostic] = hook(compiled, manifest.options)
+    else:
+        found = hook(compiled)
+    return found
+
+
 def write_files(files: Mapping[str, str], out_dir: Path, encoding: str = "ascii") -> list[Path]:
-    """Write every file atomically (temp file in ``out_dir``, then rename). All texts are encoded
-    before the first file is written, so an encoding problem leaves nothing behind."""
+    """Write every file atomically: all texts are encoded, then each is written to a temporary
+    file in ``out_dir``, and only when all of them are complete are they renamed into place. An
+    encoding or disk problem leaves no file half-written and no temporary file behind."""
     encoded = {}
     for fname, text in files.items():
         try:
@@ -290,16 +840,16 @@ def write_files(files: Mapping[str, str], out_dir: Path, encoding: str = "ascii"
             bad = text[exc.start : exc.end]
             raise PostError(f"{fname}: character {bad!r} cannot be written in {encoding}") from exc
     out_dir.mkdir(parents=True, exist_ok=True)
-    written = []
-    for fname, data in encoded.items():
-        target = out_dir / fname
-        fd, tmp = tempfile.mkstemp(prefix=f".{fname}.", dir=out_dir)
-        try:
+    staged: list[tuple[str, Path]] = []
+    try:
+        for fname, data in encoded.items():
+            fd, tmp = tempfile.mkstemp(prefix=f".{fname}.", dir=out_dir)
+            staged.append((tmp, out_dir / fname))
             with os.fdopen(fd, "wb") as handle:
                 handle.write(data)
+        for tmp, target in staged:
             os.replace(tmp, target)
-        except BaseException:
+    finally:
+        for tmp, _ in staged:
             Path(tmp).unlink(missing_ok=True)
-            raise
-        written.append(target)
-    return written
+    return [target for _, target in staged]

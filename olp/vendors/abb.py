@@ -35,16 +35,42 @@ Sources
   reserved words are not allowed (RAPID overview manual; the reserved-word list is from memory of
   that manual: medium confidence).
 
+For the RAPID post (``posts/abb``), pinned by ``tests/posts/test_abb.py`` (every module it
+produces passes the independent ``rapidchecker``) and its golden files; RAPID reference manual
+(instructions and data types) as summarised in the project's vendor notes and as recalled, with
+the confidence given:
+
+* Module: ``MODULE name`` ... ``ENDMODULE``, data before routines, ``PROC main()`` the entry
+  (program modules); two-space indentation and upper-case keywords as RobotStudio writes them;
+  CRLF (RobotStudio's files; RAPID reads any line ending). High confidence.
+* Data: ``PERS tooldata`` / ``PERS wobjdata`` (a move's tool and work object must be persistent,
+  high confidence); targets, custom speed and zone data ``LOCAL CONST`` so that a part module's
+  names never clash with another module's (medium confidence on local shadowing global names).
+  ``tool0`` and ``wobj0`` are the predefined no-tool and world (high confidence).
+* Predefined speeddata ``v5 .. v7000`` (:data:`PREDEFINED_SPEEDS`, each ``[v, 500, 5000,
+  1000]``) and zonedata ``z0 .. z200`` (:data:`PREDEFINED_ZONES`): medium-high confidence.
+* Moves: ``MoveAbsJ jointtarget\\NoEOffs, speed, zone, tool;`` for joint targets, ``MoveJ`` /
+  ``MoveL`` / ``MoveC via, to`` with robtargets and ``\\WObj:=`` (left out for ``wobj0``).
+  ``ConfJ \\On`` / ``ConfL \\On`` make the controller take the written confdata. Joint moves are
+  limited by the speeddata's TCP speed: RAPID has no joint speed fraction (warned).
+* ``SetDO signal, 0|1;``, ``WaitDI signal, 0|1;`` (I/O by configured signal name:
+  :func:`rapid_signal`), ``WaitTime \\InPos, t;`` (the dwell starts once the robot stands
+  still, like KRL's ``WAIT SEC``), ``Name args;`` procedure calls, ``!`` comments.
+* Work objects are given in the controller's world frame, which on a delivered single-robot
+  controller is the robot's base frame (post manifest ``frames_in: robot_base``).
+
 Joint values are controller joints in rad (what the FlexPendant shows, in degrees).
 """
 
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from olp.diagnostics import Diagnostic
 from olp.geometry import pose_from
 from olp.ir import Configuration
 from olp.kinematics.configuration import ArmModel, branch_flags, make_configuration, snap
@@ -272,6 +298,145 @@ def legal_name(name: str) -> str:
     return cleaned
 
 
+def is_legal_name(name: str) -> bool:
+    """True when ``name`` is already a legal RAPID identifier (:func:`legal_name` keeps it)."""
+    return legal_name(name) == name
+
+
+# --------------------------------------------------------------------------------------------
+# Predefined data (RAPID reference manual, "speeddata" / "zonedata" / "tooldata" / "wobjdata",
+# predefined data in the BASE system module; medium-high confidence, recalled from the manual)
+
+NULL_TOOL_NAME = "tool0"
+"""The predefined tool: TCP at the flange (tool0)."""
+NULL_FRAME_NAME = "wobj0"
+"""The predefined work object: the world frame (wobj0)."""
+
+_SPEEDS_MM_S = """
+5 10 20 30 40 50 60 80 100 150 200 300 400 500 600 800 1000 1500 2000 2500 3000 4000 5000 6000
+7000
+"""
+PREDEFINED_SPEEDS = {float(v): f"v{v}" for v in _SPEEDS_MM_S.split()}
+"""Predefined speeddata by TCP speed (mm/s). Each is ``[v_tcp, 500, 5000, 1000]``."""
+SPEED_DEFAULTS = (500.0, 5000.0, 1000.0)
+"""``v_ori`` (deg/s), ``v_leax`` (mm/s), ``v_reax`` (deg/s) of the predefined speeddata; olp's
+custom speeddata use them where the program says nothing (no orientation speed limit)."""
+
+PREDEFINED_ZONES = {
+    0.3: "z0",
+    **{float(r): f"z{r}" for r in (1, 5, 10, 15, 20, 30, 40, 50, 60, 80, 100, 150, 200)},
+}
+"""Predefined zonedata by TCP zone radius ``pzone_tcp`` (mm); ``fine`` is the exact stop."""
+
+PREDEFINED_NAMES = frozenset(
+    {"tool0", "wobj0", "load0", "fine", "vmax", *PREDEFINED_SPEEDS.values()}
+    | set(PREDEFINED_ZONES.values())
+)
+"""Names the controller defines already: generated data never take them."""
+
+TOOL_MASS_PLACEHOLDER = 0.001
+"""kg, tool0's load mass: written when the station gives no mass (with a warning)."""
+
+
+def _compact(value: float, decimals: int = 3) -> str:
+    """Fixed-point with at most ``decimals``, trailing zeros (and a bare point) removed."""
+    text = _num(value, decimals)
+    if "." in text:
+        text = text.rstrip("0").rstrip(".")
+    return text
+
+
+def speed_name(speed: Any) -> str:
+    """The speeddata name of an :class:`olp.ir.Speed`: a predefined ``v100`` when the TCP speed
+    is one of :data:`PREDEFINED_SPEEDS` and no orientation limit is set, else a custom name
+    ``v21_17`` (mm/s, ``_`` for the point) or ``v100_o30`` (with ``v_ori`` 30 deg/s)."""
+    mm_s = float(speed.linear) * 1000.0
+    text = _compact(mm_s)
+    if speed.angular is None:
+        predefined = PREDEFINED_SPEEDS.get(float(text))
+        if predefined is not None:
+            return predefined
+        return "v" + text.replace(".", "_")
+    return f"v{text.replace('.', '_')}_o{_compact(math.degrees(speed.angular)).replace('.', '_')}"
+
+
+def speeddata(speed: Any) -> str:
+    """``[v_tcp, v_ori, v_leax, v_reax]`` of an :class:`olp.ir.Speed` (mm/s, deg/s)."""
+    v_ori = SPEED_DEFAULTS[0] if speed.angular is None else math.degrees(speed.angular)
+    values = [float(speed.linear) * 1000.0, v_ori, *SPEED_DEFAULTS[1:]]
+    return "[" + ",".join(_compact(v) for v in values) + "]"
+
+
+def zone_name(zone: Any) -> str:
+    """The zonedata name of an :class:`olp.ir.Zone`: ``fine``, a predefined ``z10``, or a custom
+    ``z12_5`` (radius in mm)."""
+    if zone.is_fine:
+        return "fine"
+    text = _compact(float(zone.radius) * 1000.0)
+    return PREDEFINED_ZONES.get(float(text), "z" + text.replace(".", "_"))
+
+
+def zonedata(zone: Any) -> str:
+    """A custom zonedata ``[FALSE, r, 1.5r, 1.5r, 0.15r, 1.5r, 0.15r]`` for a radius r (mm):
+    pzone_tcp, pzone_ori, pzone_eax (mm), zone_ori (deg), zone_leax (mm), zone_reax (deg).
+    The ratios are those of the predefined z10 .. z200 (olp's choice for other radii)."""
+    r = float(zone.radius) * 1000.0
+    values = [r, 1.5 * r, 1.5 * r, 0.15 * r, 1.5 * r, 0.15 * r]
+    return "[FALSE," + ",".join(_compact(v) for v in values) + "]"
+
+
+def context_values(steps: Any, options: Any = None) -> dict[str, list[dict[str, str]]]:
+    """Post hook: the custom speeddata and zonedata one file's motions need, in order of first
+    use: ``{"speeds": [{name, value}], "zones": [{name, value}]}``."""
+    speeds: dict[str, str] = {}
+    zones: dict[str, str] = {}
+    for step in steps:
+        if step.motion:
+            name = speed_name(step.speed)
+            if name not in PREDEFINED_NAMES:
+                speeds.setdefault(name, speeddata(step.speed))
+            zname = zone_name(step.zone)
+            if zname not in PREDEFINED_NAMES:
+                zones.setdefault(zname, zonedata(step.zone))
+    return {
+        "speeds": [{"name": k, "value": v} for k, v in speeds.items()],
+        "zones": [{"name": k, "value": v} for k, v in zones.items()],
+    }
+
+
+def step_values(robot: ArmModel, joints: ArrayLike, options: Any = None) -> list[dict[str, Any]]:
+    """Post hook: the confdata ``(cf1, cf4, cf6, cfx)`` of each motion's planned joints (N, 6)."""
+    conf = confdata(robot, np.asarray(joints, dtype=np.float64))
+    return [{"confdata": tuple(int(v) for v in row)} for row in conf.tolist()]
+
+
+def rapid_tooldata(tool: Any) -> str:
+    """A tooldata value ``[TRUE,[[x,y,z],[q]],[mass,[cog],[1,0,0,0],0,0,0]]`` for a
+    :class:`olp.post.PostTool`: held by the robot, TCP in tool0 (mm, quaternion); the load is the
+    station's mass (or :data:`TOOL_MASS_PLACEHOLDER`) with the centre of gravity 1 mm along the
+    flange axis, as tool0 has it (the station gives none)."""
+    mass = tool.mass if tool.mass else TOOL_MASS_PLACEHOLDER
+    return f"[TRUE,{rapid_pose(tool.pose)},[{_compact(mass)},[0,0,0.001],[1,0,0,0],0,0,0]]"
+
+
+def rapid_wobjdata(frame: Any) -> str:
+    """A wobjdata value ``[FALSE,TRUE,"",[[uf],[q]],[[0,0,0],[1,0,0,0]]]`` for a
+    :class:`olp.post.PostFrame`: not held by the robot, fixed user frame = the frame's pose in the
+    controller's reference, object frame = the user frame."""
+    return f'[FALSE,TRUE,"",{rapid_pose(frame.pose)},[[0,0,0],[1,0,0,0]]]'
+
+
+def rapid_signal(index: int, pattern: str) -> str:
+    """The name of digital signal ``index`` from a pattern such as ``"do{index}"`` (RAPID I/O is
+    by signal name, configured on the controller; a post option sets the pattern)."""
+    from olp.errors import PostError
+
+    name = pattern.format(index=index)
+    if not is_legal_name(name):
+        raise PostError(f"signal name {name!r} (from {pattern!r}) is not a legal RAPID name")
+    return name
+
+
 def _robtarget_filter(joints: ArrayLike, robot: ArmModel, pose: ArrayLike) -> str:
     """Template filter: ``joints | rapid_robtarget(robot, pose)``."""
     return rapid_robtarget(pose, confdata(robot, joints))
@@ -287,4 +452,65 @@ TEMPLATE_FILTERS = {
     "rapid_robtarget": _robtarget_filter,
     "rapid_jointtarget": rapid_jointtarget,
     "rapid_confdata": _confdata_filter,
+    "rapid_robtarget_value": rapid_robtarget,
+    "rapid_tooldata": rapid_tooldata,
+    "rapid_wobjdata": rapid_wobjdata,
+    "rapid_speed": speed_name,
+    "rapid_zone": zone_name,
+    "rapid_signal": rapid_signal,
 }
+
+
+def post_diagnostics(compiled: Any, options: Any = None) -> list[Diagnostic]:
+    """What the RAPID post cannot say exactly.
+
+    * ``joint_speed`` (warning): RAPID has no joint speed as a fraction of the axes' maximum;
+      MoveJ/MoveAbsJ run limited by the speeddata's TCP and orientation speeds, which olp takes
+      from the motion's linear speed (RAPID reference, MoveJ: "speed data ... for the tool
+      centre point, the tool reorientation and external axes").
+    * ``tool_load`` (warning, once per tool): the tooldata's load is a placeholder (no mass or
+      centre of gravity in the station).
+    * ``name`` (error): a call of a routine whose name is not a legal RAPID name.
+    """
+    out: list[Diagnostic] = []
+    loads: set[str] = set()
+    for step in compiled.steps:
+        ins = step.instruction
+        kind = getattr(ins, "kind", None)
+        if kind == "call" and not is_legal_name(ins.name):
+            message = f"call of {ins.name!r}: not a legal RAPID name (letters, digits, _; 32 max)"
+            out.append(Diagnostic("error", "name", message, ins.span, step.index))
+        if kind not in ("joint", "linear", "circular") or step.skipped or step.tool is None:
+            continue
+        if kind == "joint" and ins.speed.joint < 1.0:
+            out.append(_joint_speed_warning(step.index, ins))
+        if not np.array_equal(step.tool.pose, np.eye(4)) and step.tool.name not in loads:
+            loads.add(step.tool.name)
+            body = compiled.station.tool_bodies.get(step.tool.name)
+            out.append(_load_warning(step.index, ins, step.tool.name, body))
+    return out
+
+
+def _joint_speed_warning(index: int, ins: Any) -> Diagnostic:
+    return Diagnostic(
+        "warning",
+        "joint_speed",
+        f"RAPID cannot limit a joint move to {ins.speed.joint * 100:.0f} % of the axis speeds: "
+        f"it runs limited by the TCP speed {speed_name(ins.speed)} instead",
+        ins.span,
+        index,
+        hint="set the linear speed of joint moves to what the robot may reach",
+    )
+
+
+def _load_warning(index: int, ins: Any, name: str, body: Any) -> Diagnostic:
+    mass = None if body is None else body.mass
+    what = "no mass" if not mass else f"mass {mass:g} kg but no centre of gravity"
+    return Diagnostic(
+        "warning",
+        "tool_load",
+        f"tool {name!r}: the station gives {what}; its tooldata load is a placeholder",
+        ins.span,
+        index,
+        hint="identify the load on the controller (LoadIdentify) or enter it before running",
+    )

@@ -1,0 +1,24 @@
+"""Rewrites a target needs, as functions every post can share (STYLE.md: IR -> IR, not template
+hacks).
+
+* :mod:`olp.transforms.split`: cut a long program into parts that fit a controller's limits
+  (motions or instructions per file); a main program calls the parts in order. Works on an
+  :class:`olp.ir.Program` before compiling (:func:`~olp.transforms.split.split_program`) and on
+  a compiled program's steps (:func:`~olp.transforms.split.split_steps`, what
+  :func:`olp.post.render` uses, so that splitting never changes the planned joints).
+* :mod:`olp.transforms.blend`: blend capping (another module, same shape).
+
+A transform never knows a brand: name rules come in as a function (a vendor's ``legal_name``).
+"""
+
+from __future__ import annotations
+
+from olp.transforms.split import (
+    SplitLimits,
+    part_names,
+    split_bounds,
+    split_program,
+    split_steps,
+)
+
+__all__ = ["SplitLimits", "part_names", "split_bounds", "split_program", "split_steps"]
