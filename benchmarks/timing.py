@@ -11,6 +11,8 @@ Run from the repository root: ``python -m benchmarks.timing [--samples N] [--mov
   velocity and acceleration, no jerk), vectorised over all moves.
 * The discretisation error of the path timing: the LIN and a chain of blended LINs timed again on
   a grid 8x finer.
+* The path solver: olp's vectorised reachability analysis against the toppra package on the LIN
+  (same grid, same constraints).
 
 Each model is timed as the best of ``--repeats`` runs. The last lines are the headline figures,
 one per line as ``name: value unit``.
@@ -134,6 +136,9 @@ def main() -> None:
     length = lin_timed.steps[1].path_length
     trap_lin_s, trap_lin = _best(lambda: trapezoid_lin(length, 0.5, args.tcp_accel), args.repeats)
     olp_lin = lin_timed.steps[1].duration
+    reference = TimingOptions(solver="toppra")
+    ref_lin_s, ref_timed = _best(lambda: time_program(lin, options=reference), args.repeats)
+    ref_lin = ref_timed.steps[1].duration
 
     ptp = _ptp_program(station, args.moves, 0.8)
     ptp_s, ptp_timed = _best(lambda: time_program(ptp), args.repeats)
@@ -150,7 +155,8 @@ def main() -> None:
     chain_fine = time_program(chain, options=FINE).cycle_time
 
     print(f"LIN {length * 1000:.1f} mm at 500 mm/s, {samples} joint samples:")
-    print(f"  olp TOPPRA        {lin_s * 1000:10.2f} ms   estimate {olp_lin:.4f} s")
+    print(f"  olp reachability  {lin_s * 1000:10.2f} ms   estimate {olp_lin:.4f} s")
+    print(f"  toppra package    {ref_lin_s * 1000:10.2f} ms   estimate {ref_lin:.4f} s")
     print(f"  trapezoid         {trap_lin_s * 1000:10.4f} ms   estimate {trap_lin:.4f} s")
     print(f"{args.moves} joint moves at 80% speed:")
     print(f"  olp Ruckig        {ptp_s * 1000:10.2f} ms   total {olp_ptp.sum():.3f} s")
@@ -164,6 +170,9 @@ def main() -> None:
     print(f"lin_{samples}_samples_olp_time: {lin_s * 1000:.1f} ms")
     print(f"lin_{samples}_samples_trapezoid_time: {trap_lin_s * 1e6:.2f} us")
     print(f"lin_compute_ratio_olp_over_trapezoid: {lin_s / trap_lin_s:.3g} x")
+    print(f"lin_{samples}_samples_toppra_package_time: {ref_lin_s * 1000:.1f} ms")
+    print(f"lin_compute_ratio_toppra_package_over_olp: {ref_lin_s / lin_s:.3g} x")
+    print(f"lin_estimate_difference_olp_vs_toppra_package: {(olp_lin / ref_lin - 1) * 100:+.5f} %")
     print(f"lin_estimate_ratio_olp_over_trapezoid: {olp_lin / trap_lin:.4f} x")
     print(f"ptp_{args.moves}_moves_olp_time: {ptp_s * 1000:.1f} ms")
     print(f"ptp_{args.moves}_moves_trapezoid_time: {trap_ptp_s * 1000:.3f} ms")

@@ -5,9 +5,11 @@ A segment is a time window of a *time law*:
 
 * :class:`JerkProfile` — a Ruckig joint move: per axis seven phases of constant jerk;
 * :class:`PathTimeLaw` — a TOPPRA path: a joint spline ``q(s)`` and a path speed that changes
-  with constant path acceleration between gridpoints.
+  with constant path acceleration between gridpoints;
+* :class:`LineTimeLaw` — a stop-to-stop path move along a straight joint-space line, timed in
+  closed form: a trapezoid (or triangle) in the fraction of the line.
 
-Several steps share one :class:`PathTimeLaw` when their moves are blended into one path. Both
+Several steps share one :class:`PathTimeLaw` when their moves are blended into one path. All
 laws evaluate vectorised in numpy and need neither Ruckig nor TOPPRA afterwards.
 
 :func:`sample_program` samples a timed program at a fixed ``dt`` (between motions the robot holds
@@ -150,6 +152,48 @@ class PathTimeLaw:
         s, sd, sdd = self.path_state(t)
         dq, ddq = self.path(s, 1), self.path(s, 2)
         return self.path(s), dq * sd[:, None], ddq * (sd**2)[:, None] + dq * sdd[:, None]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class LineTimeLaw:
+    """Rest to rest along the straight joint line ``q0 + u (q1 - q0)``, ``u`` from 0 to 1: ``u``
+    accelerates at ``accel``, cruises, and brakes at ``accel`` (a triangle when ``ramp`` is half
+    the duration).
+
+    ``q0``, ``q1``: the line's ends (dof,) rad; ``accel``: 1/s² in fractions of the line;
+    ``ramp``: the time (s) of each of the acceleration and braking phases; ``total``: the
+    duration (s). The cruise speed is ``accel * ramp`` (1/s).
+    """
+
+    q0: FloatArray
+    q1: FloatArray
+    accel: float
+    ramp: float
+    total: float
+
+    @property
+    def duration(self) -> float:
+        return self.total
+
+    def fraction_state(self, t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Fraction of the line, its rate (1/s) and acceleration (1/s²), (T,) each, at times
+        ``t`` (T,) s; held at the ends outside ``[0, duration]``."""
+        tt = np.clip(t, 0.0, self.total)
+        rest = self.total - tt
+        a, ramp = self.accel, self.ramp
+        rising, falling = tt < ramp, rest < ramp
+        u = np.where(rising, 0.5 * a * tt**2, a * ramp * (tt - 0.5 * ramp))
+        u = np.where(falling, 1.0 - 0.5 * a * rest**2, u)
+        ud = a * np.where(rising, tt, np.where(falling, rest, ramp))
+        # At a triangle's peak both phases meet; the end holds still (as PathTimeLaw).
+        udd = np.where(rising, a, np.where(falling & (rest > 0.0), -a, 0.0))
+        return u, ud, udd
+
+    def state(self, t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Joint position, velocity, acceleration (T, dof) at times ``t`` (T,) s."""
+        u, ud, udd = self.fraction_state(t)
+        line = self.q1 - self.q0
+        return self.q0 + u[:, None] * line, ud[:, None] * line, udd[:, None] * line
 
 
 @dataclass(frozen=True, slots=True, eq=False)

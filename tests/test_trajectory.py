@@ -1,5 +1,6 @@
-"""The timed trajectory: time laws against Ruckig's and TOPPRA's own evaluators, sampling at a
-fixed step, the CSV against forward kinematics, the plot as a PNG."""
+"""The timed trajectory: time laws against Ruckig's and TOPPRA's own evaluators, the closed-form
+line law against its own derivatives, sampling at a fixed step, the CSV against forward
+kinematics, the plot as a PNG."""
 
 from __future__ import annotations
 
@@ -19,6 +20,7 @@ from olp.passes.timing import time_program
 from olp.station.loader import load_station
 from olp.station.model import Station
 from olp.trajectory import (
+    LineTimeLaw,
     PathTimeLaw,
     csv_text,
     instruction_starts,
@@ -100,6 +102,60 @@ def test_path_time_law_matches_toppra_evaluation() -> None:
     assert np.allclose(qd, reference(times, 1), atol=1e-7)
     inner = (times > 1e-3) & (times < law.duration - 1e-3)  # toppra's acceleration at the ends
     assert np.allclose(qdd[inner], reference(times[inner], 2), atol=1e-6)
+
+
+@pytest.mark.parametrize(("ramp", "total"), [(0.02, 0.1), (0.05, 0.1)])
+def test_line_time_law_is_its_own_derivative(ramp: float, total: float) -> None:
+    """A trapezoid (and a triangle, ``ramp = total / 2``) along a joint line: it starts and ends
+    at rest on the line's ends, stays on the line, and its velocity and acceleration are the
+    derivatives of its position."""
+    q0, q1 = np.array([0.1, -0.2, 0.3]), np.array([0.15, -0.25, 0.5])
+    accel = 1.0 / (ramp * (total - ramp))  # covers the line exactly
+    law = LineTimeLaw(q0=q0, q1=q1, accel=accel, ramp=ramp, total=total)
+    dt = 1e-6
+    t = np.linspace(0.0, total, 2001)
+    q, qd, qdd = law.state(t)
+    assert np.allclose(q[[0, -1]], [q0, q1], atol=1e-12) and np.allclose(qd[[0, -1]], 0.0)
+    fraction = (q - q0) / (q1 - q0)
+    assert np.allclose(fraction, fraction[:, :1], atol=1e-12)
+    assert np.all(np.diff(fraction[:, 0]) >= 0)
+    plus, minus = law.state(t + dt), law.state(t - dt)
+    inner = (t > dt) & (t < total - dt)
+    kinks = (np.abs(t - ramp) < 2 * dt) | (np.abs(t - (total - ramp)) < 2 * dt)
+    smooth = inner & ~kinks  # central differences across a jump of acceleration are off
+    assert np.allclose(((plus[0] - minus[0]) / (2 * dt))[smooth], qd[smooth], atol=1e-8)
+    assert np.allclose(((plus[1] - minus[1]) / (2 * dt))[smooth], qdd[smooth], atol=1e-4)
+    assert np.max(np.abs(qd[:, 2])) == pytest.approx(accel * ramp * (q1 - q0)[2], rel=1e-9)
+    assert law.state(np.array([-1.0, total + 1.0]))[1].tolist() == [[0.0] * 3, [0.0] * 3]
+
+
+def test_sampling_runs_through_closed_form_lines(station: Station) -> None:
+    """Fine-stopped tiny LINs (timed in closed form) sample continuously, velocity the
+    derivative of position, and end at each move's target."""
+    tool = station.tools["spindle"]
+    start = station.robot.flange_poses(Q0) @ tool.pose
+    moves: list[ir.Instruction] = [ir.JointMove(target=ir.JointTarget(joints=Q0), tool=tool)]
+    for k in range(1, 6):
+        pose = start.copy()
+        pose[:3, 3] += [2e-4 * k, 1e-4 * (k % 2), 0.0]
+        moves.append(
+            ir.LinearMove(
+                target=ir.CartesianTarget(pose=pose), speed=ir.Speed(linear=0.02), tool=tool
+            )
+        )
+    timed = time_program(resolve(ir.Program(name="t", instructions=moves), station))
+    assert timed.ok
+    assert all(isinstance(s.trajectory.law, LineTimeLaw) for s in timed.steps[1:])  # type: ignore[union-attr]
+    dt = 1e-5
+    sampled = sample_program(timed, dt=dt)
+    limits = station.robot.limits
+    central = (sampled.q[2:] - sampled.q[:-2]) / (2 * dt)
+    assert np.all(np.abs(central - sampled.qd[1:-1]) <= limits.acceleration * dt * 1.01)
+    assert np.all(np.abs(np.diff(sampled.q, axis=0)) <= limits.velocity * dt * 1.001)
+    ends = np.cumsum([s.duration for s in timed.steps])
+    for step, end in zip(timed.steps, ends, strict=True):
+        at = min(round(float(end) / dt), sampled.t.size - 1)
+        assert np.allclose(sampled.q[at], step.joints, atol=limits.velocity.max() * dt)
 
 
 def test_samples_have_a_fixed_step_and_cover_the_program(compiled: CompiledProgram) -> None:

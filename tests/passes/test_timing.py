@@ -8,8 +8,13 @@
 * Blending: faster than fine points, never faster than the rounded path at programmed speed, and
   the corner rounded like the parabola of the model.
 
+* The reachability solver against the toppra package (the reference) on the same grid.
+* Closed-form straight joint lines against TOPPRA on a finer grid, their limits on the sampled
+  trajectory, and the fallback to the solver for curved or long moves.
+
 Documented tolerances (see :mod:`olp.passes.timing`): joint velocities and TCP speed 0.1%,
-joint accelerations 0.5%, closed forms 0.5%, a finer grid 1%.
+joint accelerations 0.5%, closed forms 0.5%, a finer grid 1%, the reachability solver against
+toppra 1e-5, closed-form lines against TOPPRA on a finer grid 0.1%.
 """
 
 from __future__ import annotations
@@ -21,25 +26,31 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 import pytest
+from scipy.interpolate import CubicSpline
 
 from olp import ir
 from olp.geometry import rotation_log, rotz
 from olp.kinematics.opw import OPWParameters
 from olp.kinematics.pinocchio_model import TOOL0, build_model
 from olp.passes import timing
-from olp.passes.resolve import CompiledProgram, Step, resolve
+from olp.passes.resolve import CompiledProgram, ResolveOptions, Step, resolve
 from olp.passes.timing import (
     DEFAULT_TIMES,
+    ChainGeometry,
     TimingOptions,
+    joint_path,
+    line_profiles,
     override_speeds,
     ptp_duration,
     ptp_profile,
     speed_sweep,
+    straight_paths,
     tcp_rates,
     time_program,
 )
 from olp.station.loader import load_station
 from olp.station.model import JointLimits, Station
+from olp.trajectory import LineTimeLaw, PathTimeLaw
 
 REPO = Path(__file__).resolve().parents[2]
 Q0 = np.radians([10, -80, 95, 0, 30, 0])
@@ -48,10 +59,13 @@ FINE_GRID = TimingOptions(
     max_grid_step_rad=math.radians(0.0625),
     max_grid_turn_rad=math.radians(0.125),
     refine_points=96,
+    straight_lines=False,
 )
-"""8x finer than the defaults in every respect."""
+"""8x finer than the defaults in every respect, every path move by the solver."""
 
 VELOCITY_TOL, ACCELERATION_TOL, TCP_SPEED_TOL = 1e-3, 5e-3, 1e-3
+TOPPRA_PACKAGE = TimingOptions(solver="toppra", straight_lines=False)
+"""The toppra package on every path move: the reference."""
 
 
 @pytest.fixture(scope="module")
@@ -92,13 +106,19 @@ def _lin(
 
 
 def _compiled(
-    station: Station, tool: ir.Tool, *moves: ir.Instruction, options: TimingOptions | None = None
+    station: Station,
+    tool: ir.Tool,
+    *moves: ir.Instruction,
+    options: TimingOptions | None = None,
+    resolving: ResolveOptions | None = None,
 ) -> CompiledProgram:
     start = ir.JointMove(target=ir.JointTarget(joints=Q0), tool=tool)
     program = ir.Program(name="t", instructions=[start, *moves])
-    compiled = resolve(program, station)
+    compiled = resolve(program, station, resolving)
     assert compiled.ok, [d.message for d in compiled.diagnostics]
-    return time_program(compiled, options=options)
+    timed = time_program(compiled, options=options)
+    assert timed.ok, [d.message for d in timed.diagnostics]
+    return timed
 
 
 # --------------------------------------------------------------------------------------------
@@ -334,6 +354,45 @@ def test_limits_hold_on_the_sampled_trajectory(station: Station, tool: ir.Tool, 
     assert np.max(speed) <= programmed * (1 + TCP_SPEED_TOL)
 
 
+@pytest.mark.parametrize("count", [2, 3, 4, 7])
+def test_joint_path_is_scipys_not_a_knot_spline(count: int) -> None:
+    """Through three samples olp builds the parabola itself (scipy's dense solve is slow)."""
+    rng = np.random.default_rng(count)
+    s = np.cumsum(rng.uniform(0.1, 1.0, count)) - 0.1
+    q = rng.normal(size=(count, 6))
+    ours = joint_path(ChainGeometry(s=s, q=q, boundaries=s[[0, -1]], lengths=np.ones(1)))
+    scipys = CubicSpline(s, q)
+    x = np.linspace(s[0], s[-1], 101)
+    for order in range(3):
+        assert np.allclose(ours(x, order), scipys(x, order), rtol=0, atol=1e-12)
+    assert ours.dof == 6 and ours.path_interval.tolist() == [s[0], s[-1]]
+
+
+@pytest.mark.parametrize("case", ["accel-limited LIN", "blended chain", "179 degree blend"])
+def test_reachability_solver_matches_the_toppra_package(
+    station: Station, tool: ir.Tool, case: str
+) -> None:
+    """The same problem (grid, constraints, discretisation) solved by olp's vectorised
+    reachability analysis and by the toppra package's per-stage loop."""
+    where, moves = _cases(station, tool)[case]
+    ours = _compiled(where, tool, *moves)
+    reference = _compiled(where, tool, *moves, options=TOPPRA_PACKAGE)
+    for a, b in zip(ours.steps[1:], reference.steps[1:], strict=True):
+        assert a.duration == pytest.approx(b.duration, rel=1e-5)
+
+
+@pytest.mark.parametrize("sweeps", [0, 10**9])
+def test_reachability_numpy_sweeps_and_ordered_pass_agree(
+    station: Station, tool: ir.Tool, sweeps: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """All stages by the ordered pass (0 numpy sweeps) or all by numpy sweeps: the same law."""
+    where, moves = _cases(station, tool)["accel-limited LIN"]
+    default = _compiled(where, tool, *moves)
+    monkeypatch.setattr(timing, "_VECTOR_SWEEPS", sweeps)
+    other = _compiled(where, tool, *moves)
+    assert other.steps[1].duration == pytest.approx(default.steps[1].duration, rel=1e-12)
+
+
 def test_tcp_speed_holds_per_instruction(station: Station, tool: ir.Tool) -> None:
     """In a chain of different speeds each instruction's own speed holds up to the boundary."""
     moves = _cases(station, tool)["blended chain"][1]
@@ -518,3 +577,117 @@ def test_an_unevenly_sampled_circle_is_timed_by_its_tcp_speed(
     tcp = (robot.flange_poses(timed.trajectory.state(t)[0]) @ tool.pose)[:, :3, 3]
     measured = np.linalg.norm(np.diff(tcp, axis=0), axis=-1) / np.diff(t)
     assert np.max(measured) <= speed * (1 + TCP_SPEED_TOL)
+
+
+# --------------------------------------------------------------------------------------------
+# Stop-to-stop moves along straight joint lines: closed form
+
+
+SHORT_LINES = {
+    "0.1 mm, too short to cruise": ([0.0, 1e-4, 0.0], 0.05),
+    "0.5 mm at 10 mm/s, TCP-limited": ([0.0, 1e-4, 5e-4], 0.01),
+    "0.2 mm at 0.5 m/s, too short to cruise": ([2e-4, 1e-4, 5e-4], 0.5),
+}
+"""Fine-stopped LINs one after the other (target offset from the start pose in m, speed m/s),
+one resolved interval each."""
+
+
+def _short_lines(
+    station: Station, tool: ir.Tool, options: TimingOptions | None = None
+) -> CompiledProgram:
+    moves = [_lin(station, tool, offset, speed) for offset, speed in SHORT_LINES.values()]
+    return _compiled(station, tool, *moves, options=options)
+
+
+def test_short_straight_moves_are_timed_in_closed_form_as_toppra_would(
+    station: Station, tool: ir.Tool
+) -> None:
+    """Against the solver on a grid 8x finer: within 0.1%, and never below it by more than that
+    grid's own error; against the toppra package where it finds a time law: within 0.1%."""
+    lines = _short_lines(station, tool)
+    fine = _short_lines(station, tool, FINE_GRID)
+    for a, b in zip(lines.steps[1:], fine.steps[1:], strict=True):
+        assert a.trajectory is not None and isinstance(a.trajectory.law, LineTimeLaw)
+        assert a.duration == pytest.approx(b.duration, rel=1e-3)
+        assert a.duration >= b.duration * (1 - 1e-4)
+        assert a.path_length == pytest.approx(b.path_length, rel=1e-9)
+    # The toppra package itself, on its default grid (on the finer one it finds cusps): it
+    # finds no time law on the 0.1 mm move.
+    reference = time_program(resolve(lines.program, station), options=TOPPRA_PACKAGE)
+    assert [(d.kind, d.index) for d in reference.diagnostics] == [("timing", 1)]
+    for a, b in zip(lines.steps[2:], reference.steps[2:], strict=True):
+        assert isinstance(b.trajectory.law, PathTimeLaw)  # type: ignore[union-attr]
+        assert a.duration == pytest.approx(b.duration, rel=1e-3)
+
+
+@pytest.mark.parametrize("case", list(SHORT_LINES))
+def test_closed_form_lines_hold_the_limits_on_the_sampled_trajectory(
+    station: Station, tool: ir.Tool, case: str
+) -> None:
+    index = list(SHORT_LINES).index(case) + 1
+    speed = SHORT_LINES[case][1]
+    step = _short_lines(station, tool).steps[index]
+    assert step.trajectory is not None and isinstance(step.trajectory.law, LineTimeLaw)
+    assert step.path is not None
+    t = np.linspace(0.0, step.duration, 20001)
+    q, qd, qdd = step.trajectory.state(t)
+    lim = station.robot.limits
+    assert np.allclose(q[[0, -1]], step.path[[0, -1]], atol=1e-12)
+    assert np.max(np.abs(qd) / lim.velocity) <= 1 + 1e-9
+    assert np.max(np.abs(qdd) / lim.acceleration) == pytest.approx(1.0, rel=1e-9)
+    tcp = (station.robot.flange_poses(q) @ tool.pose)[:, :3, 3]
+    tcp_speed = np.linalg.norm(np.diff(tcp, axis=0), axis=-1) / np.diff(t)
+    assert np.max(tcp_speed) <= speed * (1 + TCP_SPEED_TOL)
+    if "TCP-limited" in case:  # it cruises at the programmed speed, within the bound
+        assert np.max(tcp_speed) >= speed * (1 - 1e-3)
+
+
+def test_the_solver_takes_curved_and_long_moves(station: Station, tool: ir.Tool) -> None:
+    """A 50 mm LIN (11 samples, a curved joint path) and a 20 mm LIN resolved as one interval
+    (straight in joint space, but its TCP rate varies by more than the bound allows) are timed
+    by the solver; the closed form stays for the short move beside them."""
+    curved = _lin(station, tool, [0.0, 0.05, 0.0], 0.1)
+    coarse = ResolveOptions(step_m=1.0, step_rad=1.0)
+    long = _lin(station, tool, [0.0, 0.02, 0.0], 0.1)
+    short = _lin(station, tool, [0.0, 0.0201, 0.0], 0.05)
+    laws = [s.trajectory.law for s in _compiled(station, tool, curved).steps[1:]]  # type: ignore[union-attr]
+    both = _compiled(station, tool, long, short, resolving=coarse)
+    laws += [s.trajectory.law for s in both.steps[1:]]  # type: ignore[union-attr]
+    assert [type(law) for law in laws] == [PathTimeLaw, PathTimeLaw, LineTimeLaw]
+    step = both.steps[1]
+    assert step.path is not None and len(step.path) == 2
+    bound = line_profiles(
+        step.path[:1],
+        step.path[1:],
+        station.robot,
+        tool.pose[None],
+        np.array([0.1]),
+        np.array([np.inf]),
+    ).excess
+    assert bound[0] > 1e-3
+
+
+def test_collinear_samples_make_a_line_and_a_bend_does_not(station: Station, tool: ir.Tool) -> None:
+    q1 = Q0 + np.radians([0.02, -0.01, 0.015, 0.0, 0.01, 0.02])
+    line = Q0 + np.linspace(0.0, 1.0, 5)[:, None] * (q1 - Q0)
+    bent = line.copy()
+    bent[2] += [2e-7, 0.0, 0.0, 0.0, 0.0, 0.0]
+    back = line[[0, 2, 1, 3, 4]]
+    assert straight_paths([line, bent, back, line[[0, 4]]], 1e-7).tolist() == [
+        True,
+        False,
+        False,
+        True,
+    ]
+    move = ir.LinearMove(target=ir.JointTarget(joints=q1), speed=ir.Speed(linear=0.05), tool=tool)
+    program = ir.Program(name="t", instructions=(move, move))
+    steps = tuple(
+        Step(index=i, instruction=move, joints=q1, path=path, tool=tool, frame=ir.WORLD)
+        for i, path in enumerate([line, bent])
+    )
+    timed = time_program(CompiledProgram(program, station, Q0, steps))
+    assert timed.ok
+    kinds = [type(s.trajectory.law) for s in timed.steps]  # type: ignore[union-attr]
+    assert kinds == [LineTimeLaw, PathTimeLaw]
+    # the same move to 2e-7 rad; the solver's default grid is ~1% slow on so short a path
+    assert timed.steps[0].duration == pytest.approx(timed.steps[1].duration, rel=2e-2)
