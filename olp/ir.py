@@ -163,6 +163,15 @@ def _check_rigid(pose: FloatArray, what: str) -> None:
         raise IRError(f"{what}: last row must be [0, 0, 0, 1]")
 
 
+def _freeze_optional_pose(item: Tool | Frame, kind: str) -> None:
+    """Validate a tool's or frame's pose (if any) and store a read-only copy."""
+    if item.pose is not None:
+        what = f"{kind} {item.name!r} pose"
+        pose = _frozen_array(item.pose, (4, 4), what)
+        _check_rigid(pose, what)
+        object.__setattr__(item, "pose", pose)
+
+
 @_array_eq
 @dataclass(frozen=True, slots=True, kw_only=True, eq=False)
 class Tool:
@@ -176,10 +185,7 @@ class Tool:
     number: int | None = None
 
     def __post_init__(self) -> None:
-        if self.pose is not None:
-            pose = _frozen_array(self.pose, (4, 4), f"Tool {self.name!r} pose")
-            _check_rigid(pose, f"Tool {self.name!r} pose")
-            object.__setattr__(self, "pose", pose)
+        _freeze_optional_pose(self, "Tool")
 
 
 @_array_eq
@@ -195,10 +201,7 @@ class Frame:
     number: int | None = None
 
     def __post_init__(self) -> None:
-        if self.pose is not None:
-            pose = _frozen_array(self.pose, (4, 4), f"Frame {self.name!r} pose")
-            _check_rigid(pose, f"Frame {self.name!r} pose")
-            object.__setattr__(self, "pose", pose)
+        _freeze_optional_pose(self, "Frame")
 
 
 WORLD = Frame(name="world", pose=np.eye(4), number=0)
