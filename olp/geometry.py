@@ -92,6 +92,24 @@ def wrap_half_open(angles: ArrayLike) -> FloatArray:
     return np.where(wrapped <= -np.pi + 1e-12, wrapped + 2 * np.pi, wrapped)
 
 
+def rotation_from_quaternion(quaternion: ArrayLike) -> FloatArray:
+    """Rotations (..., 3, 3) from quaternions ``[w, x, y, z]`` (w first), (..., 4), normalised
+    first. Used by ABB robtargets and by station files (``quat:``)."""
+    q = np.asarray(quaternion, dtype=np.float64)
+    w, x, y, z = np.moveaxis(q / np.linalg.norm(q, axis=-1, keepdims=True), -1, 0)
+    r = np.empty((*q.shape[:-1], 3, 3))
+    r[..., 0, 0] = 1 - 2 * (y * y + z * z)
+    r[..., 0, 1] = 2 * (x * y - w * z)
+    r[..., 0, 2] = 2 * (x * z + w * y)
+    r[..., 1, 0] = 2 * (x * y + w * z)
+    r[..., 1, 1] = 1 - 2 * (x * x + z * z)
+    r[..., 1, 2] = 2 * (y * z - w * x)
+    r[..., 2, 0] = 2 * (x * z - w * y)
+    r[..., 2, 1] = 2 * (y * z + w * x)
+    r[..., 2, 2] = 1 - 2 * (x * x + y * y)
+    return r
+
+
 def pose_from(rotation: ArrayLike, position: ArrayLike) -> FloatArray:
     """Assemble poses from rotations (..., 3, 3) and positions (..., 3) in metres."""
     r = np.asarray(rotation, dtype=np.float64)

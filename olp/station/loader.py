@@ -46,7 +46,7 @@ import yaml
 
 from olp import vendors
 from olp.errors import StationError, line_of
-from olp.geometry import pose_from, rotation_from_zyx
+from olp.geometry import pose_from, rotation_from_quaternion, rotation_from_zyx
 from olp.ir import Frame, SourceSpan, Tool
 from olp.kinematics.base import JointCoupling, Kinematics
 from olp.kinematics.models import ChainKinematics, OPWKinematics, URKinematics, default_seeds
@@ -223,14 +223,7 @@ def _quat_to_rotation(doc: _Doc, q: np.ndarray, path: Path_) -> np.ndarray:
     norm = float(np.linalg.norm(q))
     if not 0.99 < norm < 1.01:
         raise doc.error((*path, "quat"), f"quaternion must be unit length, its norm is {norm:.6g}")
-    w, x, y, z = q / norm
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-        ]
-    )
+    return rotation_from_quaternion(q)
 
 
 # --------------------------------------------------------------------------------------------

@@ -71,7 +71,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from olp.diagnostics import Diagnostic
-from olp.geometry import pose_from
+from olp.geometry import (
+    pose_from,
+    rotation_from_quaternion,
+)
 from olp.ir import Configuration
 from olp.kinematics.configuration import ArmModel, branch_flags, make_configuration, snap
 
@@ -130,23 +133,6 @@ def canonical_quaternion(quaternion: ArrayLike) -> FloatArray:
     first = np.argmax(big, axis=-1)
     lead = np.take_along_axis(q, first[..., None], axis=-1)
     return np.where(lead < 0, -q, q) + 0.0
-
-
-def rotation_from_quaternion(quaternion: ArrayLike) -> FloatArray:
-    """Rotations (..., 3, 3) from quaternions ``[w, x, y, z]`` (..., 4), normalised first."""
-    q = np.asarray(quaternion, dtype=np.float64)
-    w, x, y, z = np.moveaxis(q / np.linalg.norm(q, axis=-1, keepdims=True), -1, 0)
-    r = np.empty((*q.shape[:-1], 3, 3))
-    r[..., 0, 0] = 1 - 2 * (y * y + z * z)
-    r[..., 0, 1] = 2 * (x * y - w * z)
-    r[..., 0, 2] = 2 * (x * z + w * y)
-    r[..., 1, 0] = 2 * (x * y + w * z)
-    r[..., 1, 1] = 1 - 2 * (x * x + z * z)
-    r[..., 1, 2] = 2 * (y * z - w * x)
-    r[..., 2, 0] = 2 * (x * z - w * y)
-    r[..., 2, 1] = 2 * (y * z + w * x)
-    r[..., 2, 2] = 1 - 2 * (x * x + y * y)
-    return r
 
 
 def normalised_rounded(quaternion: ArrayLike, decimals: int) -> FloatArray:
