@@ -16,7 +16,7 @@ import re
 import shutil
 import subprocess
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
@@ -55,6 +55,8 @@ from olp.passes.resolve import CompiledProgram, Step
 from olp.post import find_post, render
 from olp.station.model import Station
 from olp.vendors import fanuc
+
+GoldenCheck = Callable[..., None]
 
 REPO = Path(__file__).resolve().parents[2]
 GOLDEN = REPO / "tests" / "golden" / "fanuc"
@@ -598,17 +600,12 @@ GOLDEN_CASES = {"MILLING.ls": (KUKA_CELL, MILLING), "TRANSPILE.ls": (FANUC_CELL,
 
 
 @pytest.mark.parametrize("name", list(GOLDEN_CASES))
-def test_golden(name: str, tmp_path: Path) -> None:
+def test_golden(name: str, tmp_path: Path, golden: GoldenCheck) -> None:
     cell, source = GOLDEN_CASES[name]
     result = olp.build(_station(cell), source, post="fanuc", out_dir=tmp_path)
     assert result.ok and list(result.files) == [name]
     written = (tmp_path / name).read_bytes()
-    golden = GOLDEN / name
-    if os.environ.get("OLP_UPDATE_GOLDEN") == "1":
-        golden.parent.mkdir(parents=True, exist_ok=True)
-        golden.write_bytes(written)
-        pytest.fail(f"{golden} updated: review the diff, then run again without OLP_UPDATE_GOLDEN")
-    assert written == golden.read_bytes()
+    golden(GOLDEN, {name: written}, whole_folder=False)
     assert written.isascii() and written.endswith(b"/END\r\n")
 
 

@@ -13,10 +13,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import os
 import re
 import shutil
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -35,6 +34,8 @@ from olp.post import PostManifest, find_post, post_diagnostics, render
 from olp.station.loader import load_library_robot, robot_library
 from olp.station.model import Robot, Station
 from olp.vendors import kuka
+
+GoldenCheck = Callable[..., None]
 
 REPO = Path(__file__).resolve().parents[2]
 CELL = REPO / "stations" / "kr6_milling_cell.yaml"
@@ -612,19 +613,10 @@ def _golden_files(job: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> 
 
 
 @pytest.mark.parametrize("job", [*JOBS, "job5_milling_split"])
-def test_golden(job: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    files = _golden_files(job, tmp_path, monkeypatch)
-    folder = GOLDEN / job
-    if os.environ.get("OLP_UPDATE_GOLDEN") == "1":
-        shutil.rmtree(folder, ignore_errors=True)
-        folder.mkdir(parents=True)
-        for name, data in files.items():
-            (folder / name).write_bytes(data)
-        pytest.fail(f"{folder} updated: review the diff, then run again without OLP_UPDATE_GOLDEN")
-    expected = {p.name: p.read_bytes() for p in sorted(folder.iterdir())}
-    assert sorted(files) == sorted(expected)
-    for name, data in files.items():
-        assert data == expected[name], f"{job}/{name} differs from its golden file"
+def test_golden(
+    job: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, golden: GoldenCheck
+) -> None:
+    golden(GOLDEN / job, _golden_files(job, tmp_path, monkeypatch))
 
 
 # --------------------------------------------------------------------------------------------

@@ -10,9 +10,8 @@ variable can never pass CI by accident) and state the reason in the commit.
 from __future__ import annotations
 
 import math
-import os
 import re
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from functools import cache
 from pathlib import Path
 from typing import Any
@@ -52,6 +51,8 @@ from olp.post import find_post, render
 from olp.station.model import Station
 from olp.transforms.blend import cap_blends, capped_radii
 from olp.vendors import ur
+
+GoldenCheck = Callable[..., None]
 
 REPO = Path(__file__).resolve().parents[2]
 GOLDEN = REPO / "tests" / "golden" / "ur"
@@ -472,17 +473,12 @@ GOLDEN_CASES = {
 
 
 @pytest.mark.parametrize("name", list(GOLDEN_CASES))
-def test_golden(name: str, tmp_path: Path) -> None:
+def test_golden(name: str, tmp_path: Path, golden: GoldenCheck) -> None:
     cell, source = GOLDEN_CASES[name]
     result = _build(_station(cell), source, out_dir=tmp_path)
     assert result.ok and list(result.files) == [name]
     written = (tmp_path / name).read_bytes()
-    golden = GOLDEN / name
-    if os.environ.get("OLP_UPDATE_GOLDEN") == "1":
-        golden.parent.mkdir(parents=True, exist_ok=True)
-        golden.write_bytes(written)
-        pytest.fail(f"{golden} updated: review the diff, then run again without OLP_UPDATE_GOLDEN")
-    assert written == golden.read_bytes()
+    golden(GOLDEN, {name: written}, whole_folder=False)
     assert b"\r" not in written and written.endswith(b"end\n") and written.isascii()
 
 
