@@ -100,6 +100,8 @@ from olp.ir import (
     Tool,
 )
 from olp.passes.resolve import CompiledProgram, Step
+from olp.posts.sandbox import make_environment
+from olp.posts.view import Modal, changed
 from olp.resources import data_path
 from olp.transforms.split import LIMIT_KEYS, SplitLimits, part_names, split_steps
 
@@ -142,17 +144,34 @@ def available_posts() -> dict[str, Path]:
 
 
 def find_post(name_or_path: str) -> PostManifest:
-    """A post by name (bundled or entry point) or by folder path (``./my_posts/kuka_line3``)."""
-    folder = Path(name_or_path)
-    if not (folder / "post.yaml").is_file():
+    """A post by name (bundled or entry point) or by folder path (``./my_posts/kuka_line3``).
+
+    A bare name (no path separator, not starting with ``.`` or ``~``) is only ever a bundled or
+    installed post: a folder of that name in the working directory never replaces it, so a
+    cloned project cannot slip its own templates in for ``--post kuka``. A folder post is used
+    only when the user names it as a path.
+    """
+    if not is_post_path(name_or_path):
         posts = available_posts()
         if name_or_path not in posts:
+            hint = None
+            if (Path(name_or_path) / "post.yaml").is_file():
+                hint = f"to use the folder {name_or_path!r}, name it as a path: ./{name_or_path}"
             raise UsageError(
-                f"unknown post {name_or_path!r}: not a folder with post.yaml, and not one of "
-                f"{', '.join(posts) or 'none'}"
+                f"unknown post {name_or_path!r}: the posts are {', '.join(posts) or 'none'}",
+                hint=hint,
             )
-        folder = posts[name_or_path]
+        return load_manifest(posts[name_or_path])
+    folder = Path(name_or_path).expanduser()
+    if not (folder / "post.yaml").is_file():
+        raise UsageError(f"post folder {name_or_path!r} has no post.yaml")
     return load_manifest(folder)
+
+
+def is_post_path(name_or_path: str) -> bool:
+    """Whether ``--post`` names a folder (a path) rather than a registered post."""
+    text = str(name_or_path)
+    return "/" in text or "\\" in text or text.startswith((".", "~")) or Path(text).is_absolute()
 
 
 def load_manifest(folder: Path) -> PostManifest:
@@ -322,26 +341,6 @@ class PostStep:
         return self.instruction.zone
 
 
-class Modal:
-    """Tracks modal controller state while a template is rendered.
-
-    ``changed(key, value)`` is True when ``value`` differs from the last value recorded under
-    ``key`` (or none was), and records it. Arrays compare by value, tools and frames by name
-    and pose.
-    """
-
-    def __init__(self) -> None:
-        self._last: dict[str, Any] = {}
-
-    def changed(self, key: str, value: Any) -> bool:
-        return _changed(self._last, key, value)
-
-    def forget(self, key: str) -> str:
-        """Drop ``key`` (e.g. after a call that may change the state); renders as ''."""
-        self._last.pop(key, None)
-        return ""
-
-
 def build_steps(compiled: CompiledProgram) -> list[PostStep]:
     """The template view of every compiled instruction as one file (generic names, no vendor
     values), with modal-state change flags."""
@@ -489,16 +488,16 @@ class _ProgramView:
         ins: Any = step.instruction
         motion = self.motions[step.index]
         flags = {
-            "new_tool": _changed(last, "tool", step.tool),
-            "new_frame": _changed(last, "frame", step.frame),
-            "new_zone": _changed(last, "zone", ins.zone),
+            "new_tool": changed(last, "tool", step.tool),
+            "new_frame": changed(last, "frame", step.frame),
+            "new_zone": changed(last, "zone", ins.zone),
         }
         if isinstance(ins, JointMove):
             speed = (ins.speed.joint, ins.speed.joint_acceleration)
-            flags["new_joint_speed"] = _changed(last, "joint_speed", speed)
+            flags["new_joint_speed"] = changed(last, "joint_speed", speed)
         else:
             speed = (ins.speed.linear, ins.speed.angular)
-            flags["new_linear_speed"] = _changed(last, "linear_speed", speed)
+            flags["new_linear_speed"] = changed(last, "linear_speed", speed)
         point, via = names.points[step.index]
         return PostStep(
             step.index,
@@ -537,20 +536,6 @@ def _is_null(obj: Tool | Frame, null: Tool | Frame) -> bool:
 def _via(step: Step) -> FloatArray | None:
     ins = step.instruction
     return np.array(ins.via.pose) if isinstance(ins, CircularMove) else None
-
-
-def _changed(last: dict[str, Any], key: str, value: Any) -> bool:
-    same = key in last and _same(last[key], value)
-    last[key] = value
-    return not same
-
-
-def _same(a: Any, b: Any) -> bool:
-    if hasattr(a, "pose") and hasattr(b, "pose"):
-        return bool(a.name == b.name and np.array_equal(a.pose, b.pose))
-    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
-        return bool(np.array_equal(a, b))
-    return bool(a == b)
 
 
 def _pose_in_frame(step: Step, flange: FloatArray) -> FloatArray:
@@ -655,8 +640,6 @@ class _Renderer:
     """Renders one compiled program through one post, for a given split."""
 
     def __init__(self, compiled: CompiledProgram, manifest: PostManifest, name: str | None):
-        import jinja2
-
         self.compiled = compiled
         self.manifest = manifest
         self.vendor = _vendor_module(manifest)
@@ -664,16 +647,10 @@ class _Renderer:
         self.max_length: int | None = getattr(self.vendor, "MAX_NAME_LENGTH", None)
         self.name = self.legal(name or compiled.program.name)
         self.view = _ProgramView(compiled, self.vendor, manifest)
-        self.env = jinja2.Environment(
-            loader=jinja2.FileSystemLoader(str(manifest.folder)),
-            undefined=jinja2.StrictUndefined,
-            keep_trailing_newline=True,
-            trim_blocks=True,
-            lstrip_blocks=True,
-            autoescape=False,
-        )
         filters: Mapping[str, Callable[..., Any]] = getattr(self.vendor, "TEMPLATE_FILTERS", {})
-        self.env.filters.update({"num": num, "deg": math.degrees, "basename": basename, **filters})
+        self.env = make_environment(
+            manifest.folder, {"num": num, "deg": math.degrees, "basename": basename, **filters}
+        )
         self.main_file_names: set[str] = set()
 
     def render(self, parts: list[tuple[Step, ...]]) -> dict[str, str]:

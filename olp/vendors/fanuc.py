@@ -529,7 +529,9 @@ def number_lines(body: str) -> str:
             continue
         count += 1
         out.append(f"{count:4d}:{line}")
-    return "\n".join(out)
+    from olp.posts.sandbox import SafeText
+
+    return SafeText("\n".join(out))
 
 
 def line_count(body: str) -> int:

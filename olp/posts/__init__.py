@@ -1,0 +1,1 @@
+"""Post-processors: the sandboxed template environment and the template view."""
