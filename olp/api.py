@@ -194,6 +194,10 @@ def build(
     """
     from olp.post import find_post, render, write_files
 
+    if out_dir is not None:
+        from olp.output import check_output_folder
+
+        check_output_folder(out_dir)
     if not isinstance(station, Station):
         station = load_station(station)
     notes: tuple[Diagnostic, ...] = ()

@@ -46,12 +46,13 @@ class OlpError(Exception):
         lines = [f"{where}{self.kind}: {self.message}"]
         if self.source_line is not None and self.span is not None:
             text = self.source_line.rstrip("\r\n").expandtabs(1)
-            lines.append(f"    {text}")
             start = max(self.span.column - 1, 0)
             width = 1
             if self.span.end_line == self.span.line and self.span.end_column is not None:
                 width = max(self.span.end_column - self.span.column, 1)
+            text, start, width = excerpt(text, start, width)
             width = max(1, min(width, len(text) - start)) if start < len(text) else 1
+            lines.append(f"    {text}")
             lines.append("    " + " " * start + "^" * width)
         if self.hint:
             lines.append(f"    hint: {self.hint}")
@@ -83,6 +84,26 @@ class UsageError(OlpError):
     """olp was called wrongly (unknown post, missing file, bad option)."""
 
     kind = "usage error"
+
+
+EXCERPT_WIDTH = 120
+"""Characters of a source line shown under an error: a 20 MB CSV line is not echoed in full."""
+
+
+def excerpt(text: str, start: int, width: int, limit: int = EXCERPT_WIDTH) -> tuple[str, int, int]:
+    """A window of at most ``limit`` printable characters of ``text`` around the columns
+    ``start .. start + width`` (0-based), with ``...`` where it was cut; returns the window and
+    the start and width of the caret in it. Control characters are shown as ``?``."""
+    clean = "".join(ch if ch.isprintable() else "?" for ch in text[: start + limit + 1])
+    if len(text) <= limit:
+        return clean, start, width
+    width = min(width, limit // 2)
+    lo = max(0, min(start - limit // 3, len(text) - limit))
+    hi = lo + limit
+    head = "..." if lo > 0 else ""
+    tail = "..." if hi < len(text) else ""
+    window = clean[lo:hi]
+    return head + window + tail, start - lo + len(head), width
 
 
 def line_of(text: str, line: int) -> str | None:

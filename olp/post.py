@@ -77,8 +77,6 @@ from __future__ import annotations
 import importlib
 import inspect
 import math
-import os
-import tempfile
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -806,27 +804,20 @@ def post_diagnostics(compiled: CompiledProgram, manifest: PostManifest) -> list[
 
 
 def write_files(files: Mapping[str, str], out_dir: Path, encoding: str = "ascii") -> list[Path]:
-    """Write every file atomically: all texts are encoded, then each is written to a temporary
-    file in ``out_dir``, and only when all of them are complete are they renamed into place. An
-    encoding or disk problem leaves no file half-written and no temporary file behind."""
+    """Encode every file (a character the encoding lacks is a PostError naming the file, line
+    and column), then write them as one set into ``out_dir`` (:func:`olp.output.write_folder`:
+    all or nothing, stale parts of an earlier build removed)."""
+    from olp.output import write_folder
+
     encoded = {}
     for fname, text in files.items():
         try:
             encoded[fname] = text.encode(encoding)
         except UnicodeEncodeError as exc:
             bad = text[exc.start : exc.end]
-            raise PostError(f"{fname}: character {bad!r} cannot be written in {encoding}") from exc
-    out_dir.mkdir(parents=True, exist_ok=True)
-    staged: list[tuple[str, Path]] = []
-    try:
-        for fname, data in encoded.items():
-            fd, tmp = tempfile.mkstemp(prefix=f".{fname}.", dir=out_dir)
-            staged.append((tmp, out_dir / fname))
-            with os.fdopen(fd, "wb") as handle:
-                handle.write(data)
-        for tmp, target in staged:
-            os.replace(tmp, target)
-    finally:
-        for tmp, _ in staged:
-            Path(tmp).unlink(missing_ok=True)
-    return [target for _, target in staged]
+            line = text.count("\n", 0, exc.start) + 1
+            column = exc.start - (text.rfind("\n", 0, exc.start) + 1) + 1
+            raise PostError(
+                f"{fname}:{line}:{column}: character {bad!r} cannot be written in {encoding}"
+            ) from exc
+    return write_folder(encoded, out_dir)

@@ -16,9 +16,10 @@ import numpy as np
 import pytest
 
 import olp
-from olp import ir
+from olp import ir, output
 from olp.cli import main
 from olp.errors import PostError, UsageError
+from olp.output import MANIFEST
 from olp.passes.resolve import CompiledProgram
 from olp.post import (
     Modal,
@@ -318,15 +319,27 @@ def test_write_files_replaces_atomically_and_leaves_no_temp_files(tmp_path: Path
     write_files({"a.src": "one\n"}, out)
     write_files({"a.src": "two\n"}, out)
     assert (out / "a.src").read_text() == "two\n"
-    assert sorted(p.name for p in out.iterdir()) == ["a.src"]
+    assert sorted(p.name for p in out.iterdir()) == [MANIFEST, "a.src"]
+    assert [p.name for p in tmp_path.iterdir()] == ["out"]
 
 
-def test_a_failed_rename_leaves_no_temp_file(tmp_path: Path) -> None:
+def test_a_failed_write_leaves_the_old_set_and_no_staging_folder(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     out = tmp_path / "out"
-    (out / "b.src").mkdir(parents=True)  # a folder where a file should go: rename fails
-    with pytest.raises(OSError):
+    write_files({"a.src": "old\n"}, out)
+    real = output._write_new
+
+    def fail_on_b(path: Path, data: bytes) -> None:
+        if path.name == "b.src":
+            raise OSError(28, "No space left on device")
+        real(path, data)
+
+    monkeypatch.setattr(output, "_write_new", fail_on_b)
+    with pytest.raises(UsageError, match="No space left"):
         write_files({"a.src": "one\n", "b.src": "two\n"}, out)
-    assert sorted(p.name for p in out.iterdir() if p.name.startswith(".")) == []
+    assert (out / "a.src").read_text() == "old\n"
+    assert [p.name for p in tmp_path.iterdir()] == ["out"]
 
 
 def _build_in_subprocess(tmp_path: Path, env: dict[str, str]) -> dict[str, bytes]:
@@ -335,10 +348,10 @@ def _build_in_subprocess(tmp_path: Path, env: dict[str, str]) -> dict[str, bytes
         "import sys; from olp.cli import main\n"
         "for post in ('kuka', 'abb'):\n"
         f"    assert main(['build', {str(CELL)!r}, {str(MILLING)!r}, '--post', post, "
-        f"'-o', {str(out)!r}, '-q']) == 0\n"
+        f"'-o', {str(out)!r} + '/' + post, '-q']) == 0\n"
     )
     subprocess.run([sys.executable, "-c", code], check=True, env={**os.environ, **env})
-    return {p.name: p.read_bytes() for p in sorted(out.iterdir())}
+    return {p.name: p.read_bytes() for p in sorted(out.glob("*/*")) if p.name != MANIFEST}
 
 
 def test_same_bytes_whatever_the_locale_and_hash_seed(tmp_path: Path) -> None:

@@ -136,10 +136,11 @@ def _orientation(text: str) -> tuple[float, float, float] | None:
 
 def run(args: argparse.Namespace) -> int:
     from olp.api import build
-    from olp.commands.check import write_outputs
+    from olp.commands.check import check_report_paths, write_outputs
     from olp.report import summary
 
     require_files(args.station, args.program)
+    check_report_paths(args)
     result = build(
         args.station,
         args.program,

@@ -111,6 +111,7 @@ def run(args: argparse.Namespace) -> int:
     from olp.report import summary
 
     require_files(args.station, args.program)
+    check_report_paths(args)
     station = load_station(args.station)
     parsed = parse_program(args, station)
     compiled = compile(
@@ -124,18 +125,29 @@ def run(args: argparse.Namespace) -> int:
     return EXIT_OK if result.ok else EXIT_PROGRAM_ERRORS
 
 
+def check_report_paths(args: argparse.Namespace) -> None:
+    """Check ``--report`` and ``--sarif`` (and ``-o`` where the command has it) before anything
+    runs: a bad path is a usage error (exit 2) before any robot code is written."""
+    from olp.output import check_distinct, check_output_file, check_output_folder
+
+    paths: list[tuple[str, Path | None]] = []
+    if getattr(args, "out", None) is not None:
+        paths.append(("-o", check_output_folder(args.out)))
+    for option in ("report", "sarif"):
+        value = getattr(args, option, None)
+        paths.append((f"--{option}", check_output_file(value, f"--{option}") if value else None))
+    check_distinct(paths)
+
+
 def write_outputs(args: argparse.Namespace, result: BuildResult) -> None:
     """Write the ``--report`` JSON and the ``--sarif`` log, each atomically, if asked."""
     from importlib.metadata import version
 
-    from olp.post import write_files
+    from olp.output import write_file
     from olp.report import report_json
     from olp.sarif import sarif_json
 
-    outputs = {}
     if getattr(args, "report", None):
-        outputs[Path(args.report)] = report_json(result)
+        write_file(args.report, report_json(result).encode("utf-8"))
     if getattr(args, "sarif", None):
-        outputs[Path(args.sarif)] = sarif_json(result.diagnostics, version("olp"))
-    for path, text in outputs.items():
-        write_files({path.name: text}, path.parent, "utf-8")
+        write_file(args.sarif, sarif_json(result.diagnostics, version("olp")).encode("utf-8"))

@@ -17,12 +17,21 @@ EXIT_OK, EXIT_PROGRAM_ERRORS, EXIT_BAD_INPUT = 0, 1, 2
 
 
 def require_files(*paths: str) -> None:
-    """Raise a UsageError naming the first path that is not a readable file."""
+    """Raise a UsageError naming the first path that is not a readable file, and why."""
+    import os
+
     from olp.errors import UsageError
 
     for path in paths:
-        if not Path(path).is_file():
+        file = Path(path)
+        if file.is_dir():
+            raise UsageError(f"{path}: is a folder, not a file")
+        if not file.exists():
             raise UsageError(f"no such file: {path}")
+        if not file.is_file():
+            raise UsageError(f"{path}: is not a regular file")
+        if not os.access(file, os.R_OK):
+            raise UsageError(f"{path}: no permission to read it")
 
 
 def print_diagnostics(diagnostics: Iterable[Diagnostic], *sources: str, quiet: bool) -> None:

@@ -23,12 +23,9 @@ def run(args: argparse.Namespace) -> int:
 
     text = station_schema_json()
     if args.out:
-        from pathlib import Path
+        from olp.output import check_output_file, write_file
 
-        from olp.post import write_files
-
-        out = Path(args.out)
-        write_files({out.name: text}, out.parent, "utf-8")
+        write_file(check_output_file(args.out, "-o"), text.encode("utf-8"))
     else:
         sys.stdout.write(text)
     return EXIT_OK

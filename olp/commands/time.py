@@ -87,6 +87,7 @@ def run(args: argparse.Namespace) -> int:
     other_times = parse_times(args.time)
     if not (math.isfinite(args.dt) and args.dt > 0):
         raise UsageError(f"--dt must be a positive number of seconds, got {args.dt}")
+    _check_paths(args)
     if args.plot:
         from olp.trajectory import require_matplotlib
 
@@ -108,6 +109,16 @@ def run(args: argparse.Namespace) -> int:
         _print_sweep(compiled, linear, joint, other_times, args.quiet)
     _write_outputs(compiled, args)
     return EXIT_OK
+
+
+def _check_paths(args: argparse.Namespace) -> None:
+    from olp.output import check_distinct, check_output_file
+
+    paths = [
+        (f"--{o}", check_output_file(getattr(args, o), f"--{o}") if getattr(args, o) else None)
+        for o in ("trajectory", "plot")
+    ]
+    check_distinct(paths)
 
 
 def _speed_list(
