@@ -20,7 +20,7 @@ def __getattr__(name: str) -> Any:
 
         return getattr(api, name)
     if name == "posts":
-        from olp.post import available_posts
+        from olp.posts import available_posts
 
         return available_posts
     if name == "ir":

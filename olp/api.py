@@ -23,6 +23,7 @@ from olp.station.model import Station
 
 if TYPE_CHECKING:
     from olp.frontends.csv import CsvOptions
+    from olp.posts.base import Post
 
 
 def load_station(path: str | Path) -> Station:
@@ -176,7 +177,7 @@ class BuildResult:
 def build(
     station: Station | str | Path,
     program: Program | str | Path,
-    post: str = "kuka",
+    post: str | Post = "kuka",
     out_dir: str | Path | None = None,
     name: str | None = None,
     *,
@@ -192,7 +193,9 @@ def build(
     and ``csv_options`` go to :func:`parse` when ``program`` is a file. Files are written to
     ``out_dir`` (if given) only when no error diagnostic remains.
     """
-    from olp.post import find_post, render, write_files
+    from olp.posts import find_post
+    from olp.posts.base import Post
+    from olp.posts.render import RenderError
 
     if out_dir is not None:
         from olp.output import check_output_folder
@@ -210,19 +213,20 @@ def build(
             krl_config_dat=krl_config_dat,
         )
         program, notes = parsed.program, parsed.notes
-    manifest = find_post(post)
+    writer = post if isinstance(post, Post) else find_post(post)
     compiled = compile(program, station, options, collisions=collisions)
     diagnostics = notes + compiled.diagnostics
     if not compiled.ok:
-        return BuildResult(compiled, manifest.name, diagnostics)
-    from olp.post import post_diagnostics
-
-    extra = post_diagnostics(compiled, manifest)
-    diagnostics = diagnostics + tuple(extra)
+        return BuildResult(compiled, writer.name, diagnostics)
+    compiled, prepared = writer.prepare(compiled)
+    diagnostics = diagnostics + tuple(prepared) + tuple(writer.check(compiled))
     if has_errors(diagnostics):
-        return BuildResult(compiled, manifest.name, diagnostics)
-    files = render(compiled, manifest, name)
+        return BuildResult(compiled, writer.name, diagnostics)
+    try:
+        files = writer.render(compiled, name)
+    except RenderError as exc:
+        return BuildResult(compiled, writer.name, diagnostics + exc.diagnostics)
     written: builtins.list[Path] = []
     if out_dir is not None:
-        written = write_files(files, Path(out_dir), manifest.encoding)
-    return BuildResult(compiled, manifest.name, diagnostics, files, tuple(written))
+        written = writer.write(files, Path(out_dir))
+    return BuildResult(compiled, writer.name, diagnostics, files, tuple(written))

@@ -15,7 +15,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from olp.post import available_posts, load_manifest
+    from olp.posts import available_posts
+    from olp.posts.manifest import load_manifest
 
     for name, folder in available_posts().items():
         print(f"{name:12} {load_manifest(folder).description}")

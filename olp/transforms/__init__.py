@@ -5,7 +5,7 @@ hacks).
   (motions or instructions per file); a main program calls the parts in order. Works on an
   :class:`olp.ir.Program` before compiling (:func:`~olp.transforms.split.split_program`) and on
   a compiled program's steps (:func:`~olp.transforms.split.split_steps`, what
-  :func:`olp.post.render` uses, so that splitting never changes the planned joints).
+  :func:`olp.posts.render.render` uses, so that splitting never changes the planned joints).
 * :mod:`olp.transforms.blend`: blend capping (another module, same shape).
 
 A transform never knows a brand: name rules come in as a function (a vendor's ``legal_name``).

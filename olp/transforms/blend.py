@@ -52,7 +52,7 @@ STOP_TYPES = (Wait, WaitInput, Call)
 
 class StepLike(Protocol):
     """What the rule reads of a step: :class:`olp.passes.resolve.Step` and
-    :class:`olp.post.PostStep` both fit."""
+    :class:`olp.posts.view.PostStep` both fit."""
 
     @property
     def index(self) -> int: ...

@@ -16,7 +16,7 @@ are case-insensitive). :func:`part_names` applies the vendor's ``legal_name``.
 
 Entry points: :func:`split_bounds` (the rule on instruction kinds), :func:`split_program`
 (IR -> IR: a main program of :class:`~olp.ir.Call` instructions and the parts, for use before
-compiling) and :func:`split_steps` (a compiled program's steps, what :func:`olp.post.render`
+compiling) and :func:`split_steps` (a compiled program's steps, what :func:`olp.posts.render.render`
 uses: splitting after planning cannot change a planned joint).
 """
 
@@ -30,7 +30,7 @@ from olp.passes.resolve import Step
 
 LIMIT_KEYS = ("max_motions_per_file", "max_instructions_per_file", "max_lines_per_file")
 """The manifest keys of ``limits`` (``max_lines_per_file`` is checked by the post after
-rendering, see :func:`olp.post.render`)."""
+rendering, see :func:`olp.posts.render.render`)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -39,7 +39,7 @@ class SplitLimits:
 
     ``max_motions``: motion instructions (positions) per part. ``max_instructions``: written
     instructions of any kind per part. ``max_lines``: text lines per written file (checked on
-    the rendered text by :func:`olp.post.render`, which splits finer until it holds).
+    the rendered text by :func:`olp.posts.render.render`, which splits finer until it holds).
     """
 
     max_motions: int | None = None

@@ -27,12 +27,14 @@ import pytest
 
 import olp
 from olp import ir
-from olp.errors import PostError
+from olp.diagnostics import Diagnostic
 from olp.frontends.csv import CsvOptions
 from olp.kinematics.base import turn_variants
 from olp.kinematics.configuration import satisfies
 from olp.passes.resolve import CompiledProgram, ResolveOptions, Step
-from olp.post import PostManifest, find_post, post_diagnostics, render
+from olp.posts import find_post
+from olp.posts.abb import PREDEFINED_NAMES, speed_name, speeddata, zone_name, zonedata
+from olp.posts.base import Post
 from olp.station.loader import load_library_robot, robot_library
 from olp.station.model import Robot, Station
 from olp.vendors import abb, kuka
@@ -48,6 +50,17 @@ CELL = REPO / "stations" / "abb_irb120_pick_cell.yaml"
 KUKA_CELL = REPO / "stations" / "kr6_milling_cell.yaml"
 PICK = Path(__file__).resolve().parent / "pick_irb120.src"
 GOLDEN = REPO / "tests" / "golden" / "abb"
+
+
+def render(compiled: CompiledProgram, post: Post, name: str | None = None) -> dict[str, str]:
+    """The post's files (its transforms applied)."""
+    return post.render(compiled, name)
+
+
+def post_diagnostics(compiled: CompiledProgram, post: Post) -> list[Diagnostic]:
+    """What the post reports: its transforms' diagnostics, then its checks."""
+    prepared, found = post.prepare(compiled)
+    return found + post.check(prepared)
 
 
 def check_file(text: str) -> list[Any]:
@@ -80,9 +93,8 @@ def station() -> Station:
     return olp.load_station(CELL)
 
 
-def _post(**options: Any) -> PostManifest:
-    base = find_post("abb")
-    return dataclasses.replace(base, options={**base.options, **options})
+def _post(**options: Any) -> Post:
+    return find_post("abb", options=options)
 
 
 def _compile(station: Station, instructions: Sequence[ir.Instruction]) -> CompiledProgram:
@@ -91,7 +103,7 @@ def _compile(station: Station, instructions: Sequence[ir.Instruction]) -> Compil
     return compiled
 
 
-def _module(compiled: CompiledProgram, post: PostManifest | None = None) -> list[str]:
+def _module(compiled: CompiledProgram, post: Post | None = None) -> list[str]:
     files = rapid(render(compiled, post or _post()))
     return files["Row.mod"].split("\r\n")
 
@@ -283,8 +295,9 @@ def test_options_signals_and_configuration_monitoring(station: Station) -> None:
     post = _post(output_signal="DO10_{index}", input_signal="DI10_{index}", conf_monitoring=False)
     _, proc = _sections(_module(compiled, post))
     assert proc == ["SetDO DO10_3, 1;", "WaitDI DI10_4, 1;"]
-    with pytest.raises(PostError, match="not a legal RAPID name"):
-        render(compiled, _post(output_signal="do-{index}"))
+    found = post_diagnostics(compiled, _post(output_signal="do-{index}"))
+    assert [(d.kind, d.index) for d in found] == [("io_name", 0)]
+    assert "not a legal RAPID name" in found[0].message
 
 
 def test_circular_moves(station: Station) -> None:
@@ -315,8 +328,8 @@ def test_diagnostics(station: Station) -> None:
     found = [(d.severity, d.kind, d.index) for d in post_diagnostics(compiled, find_post("abb"))]
     assert found == [
         ("warning", "joint_speed", 0),
+        ("error", "call_name", 2),
         ("warning", "tool_load", 0),
-        ("error", "name", 2),
     ]
 
 
@@ -404,9 +417,9 @@ def test_confdata_selects_the_planned_joints(name: str) -> None:
 # Splitting
 
 
-def _split_post(tmp_path: Path, limit: int) -> PostManifest:
+def _split_post(tmp_path: Path, limit: int) -> Post:
     folder = tmp_path / "abb_small"
-    shutil.copytree(find_post("abb").folder, folder)
+    shutil.copytree(find_post("abb").manifest.folder, folder)
     text = (folder / "post.yaml").read_text()
     (folder / "post.yaml").write_text(
         text.replace("max_motions_per_file: 5000", f"max_motions_per_file: {limit}")
@@ -416,7 +429,7 @@ def _split_post(tmp_path: Path, limit: int) -> PostManifest:
 
 def test_split_modules(tmp_path: Path) -> None:
     st = olp.load_station(CELL)
-    result = olp.build(st, PICK, post=str(_split_post(tmp_path, 3).folder))
+    result = olp.build(st, PICK, post=str(_split_post(tmp_path, 3).manifest.folder))
     assert result.ok
     files = rapid(dict(result.files))
     assert list(files) == [
@@ -475,7 +488,7 @@ JOBS: dict[str, tuple[Path, str, dict[str, Any]]] = {
 
 def _golden_files(job: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> dict[str, bytes]:
     monkeypatch.chdir(REPO)  # relative sources: no machine's folders in the header comments
-    post = str(_split_post(tmp_path, 3).folder) if job == "job5_milling_split" else "abb"
+    post = str(_split_post(tmp_path, 3).manifest.folder) if job == "job5_milling_split" else "abb"
     cell, program, kwargs = JOBS["job5_milling" if job == "job5_milling_split" else job]
     result = olp.build(olp.load_station(cell), program, post=post, **kwargs)
     assert result.ok, [d.format() for d in result.diagnostics]
@@ -505,7 +518,7 @@ def test_golden(
 )
 def test_speeddata(linear: float, angular: float | None, name: str, value: str) -> None:
     speed = ir.Speed(linear=linear, angular=angular)
-    assert abb.speed_name(speed) == name and abb.speeddata(speed) == value
+    assert speed_name(_post(), speed) == name and speeddata(_post(), speed) == value
 
 
 @pytest.mark.parametrize(
@@ -513,7 +526,7 @@ def test_speeddata(linear: float, angular: float | None, name: str, value: str) 
     [(0.0, "fine"), (0.3, "z0"), (1.0, "z1"), (10.0, "z10"), (200.0, "z200"), (12.5, "z12_5")],
 )
 def test_zone_names(radius_mm: float, name: str) -> None:
-    assert abb.zone_name(ir.Zone(radius_mm / 1000.0)) == name
-    assert name in abb.PREDEFINED_NAMES or abb.zonedata(ir.Zone(radius_mm / 1000.0)).startswith(
+    assert zone_name(_post(), ir.Zone(radius_mm / 1000.0)) == name
+    assert name in PREDEFINED_NAMES or zonedata(_post(), ir.Zone(radius_mm / 1000.0)).startswith(
         "[FALSE,12.5,18.75,"
     )

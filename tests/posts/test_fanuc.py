@@ -52,7 +52,9 @@ from olp.ir import (
 )
 from olp.kinematics.configuration import satisfies
 from olp.passes.resolve import CompiledProgram, Step
-from olp.post import find_post, render
+from olp.posts import find_post
+from olp.posts.base import Post
+from olp.posts.fanuc import MAX_NAME_LENGTH, joint_percent, linear_mm_per_s, termination
 from olp.station.model import Station
 from olp.vendors import fanuc
 
@@ -71,6 +73,18 @@ SPAN = SourceSpan("t.src", 3)
 @cache
 def _station(path: Path = FANUC_CELL) -> Station:
     return olp.load_station(path)
+
+
+def render(compiled: CompiledProgram, post: Post, name: str | None = None) -> dict[str, str]:
+    """The post's files (its transforms applied)."""
+    return post.render(compiled, name)
+
+
+def post_diagnostics(compiled: CompiledProgram, post: Post | None = None) -> list[Diagnostic]:
+    """What the post reports (LS by default): its transforms' diagnostics, then its checks."""
+    post = post or find_post("fanuc")
+    prepared, found = post.prepare(compiled)
+    return found + post.check(prepared)
 
 
 def _world() -> Frame:
@@ -322,7 +336,7 @@ def test_lines_are_numbered_right_aligned() -> None:
      (0.1, "CNT100"), (0.2, "CNT100")],
 )  # fmt: skip
 def test_cnt_from_a_distance_zone(radius: float, cnt: str) -> None:
-    assert fanuc.termination(Zone(radius)) == cnt
+    assert termination(find_post("fanuc"), Zone(radius)) == cnt
 
 
 @pytest.mark.parametrize(
@@ -331,7 +345,9 @@ def test_cnt_from_a_distance_zone(radius: float, cnt: str) -> None:
      (Speed(joint=0.004, linear=0.0001), 1, 1), (Speed(joint=0.125, linear=0.0125), 13, 13)],
 )  # fmt: skip
 def test_speeds(speed: Speed, percent: int, mm_s: int) -> None:
-    assert fanuc.joint_percent(speed) == percent and fanuc.linear_mm_per_s(speed) == mm_s
+    post = find_post("fanuc")
+    assert joint_percent(post, speed) == str(percent)
+    assert linear_mm_per_s(post, speed) == str(mm_s)
 
 
 @pytest.mark.parametrize(
@@ -365,7 +381,7 @@ def test_cartesian_target_without_a_selecting_config_is_written_as_joints(
     items = [_cartesian(LinearMove, pose, joints)]
     pos = _section(_text(items), "POS")
     assert pos[2] == "\tUF : 0, UT : 0," and pos[3].startswith("\tJ1=")
-    diags = fanuc.post_diagnostics(_compiled(items))
+    diags = post_diagnostics(_compiled(items))
     assert [(d.severity, d.kind, d.index) for d in diags] == [("info", "joint_position", 0)]
 
 
@@ -374,7 +390,7 @@ def test_a_robot_without_config_gets_joint_positions() -> None:
     q = ur5e.robot.home
     items = [(LinearMove(target=CartesianTarget(pose=ur5e.robot.flange_poses(q))), q)]
     assert _section(_text(items, ur5e), "POS")[3].startswith("\tJ1=     0.000 deg")
-    kinds = [(d.severity, d.kind) for d in fanuc.post_diagnostics(_compiled(items, ur5e))]
+    kinds = [(d.severity, d.kind) for d in post_diagnostics(_compiled(items, ur5e))]
     assert kinds == [("warning", "foreign_robot"), ("info", "joint_position")]
 
 
@@ -420,20 +436,20 @@ INLINE = Tool(name="tool_l3", pose=_pose(0, 0, 200, 0, 0, 0))
         ),
         ([(SetOutput(index=0, value=True), None)], [("error", "io_range")]),
         ([(WaitInput(index=0), None)], [("error", "io_range")]),
-        ([(Call(name="spray on"), None)], [("error", "bad_call")]),
-        ([(Call(name="Spray", args=("TRUE",)), None)], [("error", "bad_call")]),
+        ([(Call(name="spray on"), None)], [("error", "call_name")]),
+        ([(Call(name="Spray", args=("TRUE",)), None)], [("error", "call_argument")]),
         ([(Call(name="Spray", args=(" -1", "2.5")), None)], []),
     ],
 )
 def test_diagnostics(items: list[tuple[Instruction, Any]], expected: list[tuple[str, str]]) -> None:
-    assert _kinds(fanuc.post_diagnostics(_compiled(items))) == expected
+    assert _kinds(post_diagnostics(_compiled(items))) == expected
 
 
 def test_setup_messages_give_the_controller_values() -> None:
     items = [
         _joint(TOOL_DOWN_Q, tool=INLINE, frame=Frame(name="weld_table", number=1)),
     ]
-    messages = [d.message for d in fanuc.post_diagnostics(_compiled(items))]
+    messages = [d.message for d in post_diagnostics(_compiled(items))]
     assert messages == [
         "positions use UFRAME[1] ('weld_table'); the controller must hold it as X 1300.000 "
         "Y 0.000 Z -125.000 W 0.000 P 0.000 R 0.000 (mm, deg)",
@@ -556,7 +572,7 @@ def test_configuration_proof_over_random_planned_joints() -> None:
         # 0.001 mm / 0.001 deg of rounding can move a joint by ~1e-3 rad near a singular pose;
         # another IK solution of the same pose lies much further away
         assert np.max(np.abs(reached - step.joints)) < 5e-3
-    notes = [d for d in fanuc.post_diagnostics(compiled) if d.kind == "joint_position"]
+    notes = [d for d in post_diagnostics(compiled) if d.kind == "joint_position"]
     assert len(notes) == as_joints > 0
 
 
@@ -566,7 +582,7 @@ def test_configuration_proof_over_random_planned_joints() -> None:
 
 def test_a_long_program_is_split_into_parts_called_by_a_main_program(tmp_path: Path) -> None:
     folder = tmp_path / "fanuc_small"
-    shutil.copytree(find_post("fanuc").folder, folder)
+    shutil.copytree(find_post("fanuc").manifest.folder, folder)
     manifest = folder / "post.yaml"
     manifest.write_text(
         manifest.read_text().replace(
@@ -579,7 +595,7 @@ def test_a_long_program_is_split_into_parts_called_by_a_main_program(tmp_path: P
     main_name = "A_VERY_LONG_PROGRAM_NAME_FOR_A_WELD_"  # upper case, cut to 36 characters
     parts = [f"A_VERY_LONG_PROGRAM_NAME_FOR_A_WE_P{k}" for k in (1, 2, 3)]  # cut to fit _Pk
     assert list(result.files) == [f"{n}.ls" for n in [main_name, *parts]]
-    assert all(len(n) <= fanuc.MAX_NAME_LENGTH for n in [main_name, *parts])
+    assert all(len(n) <= MAX_NAME_LENGTH for n in [main_name, *parts])
     main_text = result.files[f"{main_name}.ls"]
     assert _section(main_text, "MN") == [f"{k:4d}:  CALL {p} ;" for k, p in enumerate(parts, 1)]
     assert _section(main_text, "POS") == [] and "LINE_COUNT\t= 3;" in main_text

@@ -24,13 +24,16 @@ import pytest
 
 import olp
 from olp import ir
+from olp.diagnostics import Diagnostic
 from olp.errors import PostError
 from olp.frontends.csv import CsvOptions
 from olp.frontends.krl import load_krl
 from olp.kinematics.base import turn_variants
 from olp.kinematics.configuration import satisfies
 from olp.passes.resolve import CompiledProgram, ResolveOptions, Step
-from olp.post import PostManifest, find_post, post_diagnostics, render
+from olp.posts import find_post
+from olp.posts.base import Post
+from olp.posts.kuka import NAME_RULE, krl_e6pos, krl_percent, krl_point_type
 from olp.station.loader import load_library_robot, robot_library
 from olp.station.model import Robot, Station
 from olp.vendors import kuka
@@ -47,14 +50,24 @@ GOLDEN = REPO / "tests" / "golden" / "kuka"
 DEG = math.pi / 180.0
 
 
+def render(compiled: CompiledProgram, post: Post, name: str | None = None) -> dict[str, str]:
+    """The post's files (its transforms applied)."""
+    return post.render(compiled, name)
+
+
+def post_diagnostics(compiled: CompiledProgram, post: Post) -> list[Diagnostic]:
+    """What the post reports: its transforms' diagnostics, then its checks."""
+    prepared, found = post.prepare(compiled)
+    return found + post.check(prepared)
+
+
 @pytest.fixture(scope="module")
 def station() -> Station:
     return olp.load_station(CELL)
 
 
-def _post(**options: Any) -> PostManifest:
-    base = find_post("kuka")
-    return dataclasses.replace(base, options={**base.options, "ini_fold": False, **options})
+def _post(**options: Any) -> Post:
+    return find_post("kuka", options={"ini_fold": False, **options})
 
 
 def _pose(x: float, y: float, z: float, a: float, b: float, c: float) -> np.ndarray:
@@ -301,7 +314,7 @@ def test_diagnostics(station: Station) -> None:
     assert found == [
         ("warning", "zone_dropped", 0),
         ("error", "joint_speed", 0),
-        ("error", "name", 1),
+        ("error", "call_name", 1),
         ("warning", "joint_speed", 3),
     ]
 
@@ -310,7 +323,7 @@ def test_diagnostics(station: Station) -> None:
     ("fraction", "text"), [(1.0, "100"), (0.1463, "14"), (0.29, "29"), (0.5, "50"), (0.004, "1")]
 )
 def test_axis_percent_is_whole_and_rounded_down(fraction: float, text: str) -> None:
-    assert kuka.krl_percent(fraction) == text
+    assert krl_percent(_post(), fraction) == text
 
 
 def test_an_error_diagnostic_writes_nothing(station: Station, tmp_path: Path) -> None:
@@ -375,7 +388,8 @@ def test_round_trip(points: str, source: Path, station: Station, tmp_path: Path)
     for a, b in zip(compiled.motion_steps(), replanned.motion_steps(), strict=True):
         assert np.allclose(a.joints, b.joints, rtol=0, atol=1e-6)  # type: ignore[arg-type]
     # one S/T per E6POS written: every motion but the PTPs to axis values
-    e6pos = [s for s in compiled.motion_steps() if kuka.krl_point_type(_kind_view(s)) == "E6POS"]
+    post = _post()
+    e6pos = [s for s in compiled.motion_steps() if krl_point_type(post, _kind_view(s)) == "E6POS"]
     assert len(again.status_turn) == len(e6pos)
 
 
@@ -525,9 +539,9 @@ def test_robots_without_kuka_status_are_a_post_error(name: str) -> None:
 # Splitting
 
 
-def _split_post(tmp_path: Path, limit: int, **options: Any) -> PostManifest:
+def _split_post(tmp_path: Path, limit: int, **options: Any) -> Post:
     folder = tmp_path / "kuka_small"
-    shutil.copytree(find_post("kuka").folder, folder)
+    shutil.copytree(find_post("kuka").manifest.folder, folder)
     text = (folder / "post.yaml").read_text()
     text = text.replace("max_motions_per_file: 5000", f"max_motions_per_file: {limit}")
     for key, value in options.items():
@@ -602,7 +616,7 @@ JOBS: dict[str, tuple[Path, str, dict[str, Any]]] = {
 def _golden_files(job: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> dict[str, bytes]:
     monkeypatch.chdir(REPO)  # relative sources: no machine's folders in the header comments
     if job == "job5_milling_split":
-        post: str = str(_split_post(tmp_path, 3).folder)
+        post: str = str(_split_post(tmp_path, 3).manifest.folder)
         cell, program, kwargs = JOBS["job5_milling"]
     else:
         post = "kuka"
@@ -625,15 +639,15 @@ def test_golden(
 
 def test_krl_spelling_of_points() -> None:
     pose = kuka.frame_to_pose([1.5, -2.25, 300.0, -180.0, 0.0, 90.0])
-    assert kuka.krl_e6pos(pose, 6, 27) == (
+    assert krl_e6pos(_post(), pose, 6, 27) == (
         "X 1.500,Y -2.250,Z 300.000,A 180.0000,B 0.0000,C 90.0000,S 6,T 27"
     )
 
 
 @pytest.mark.parametrize(("name", "legal"), [("END", "END_"), ("lin", "lin_"), ("Lin2", "Lin2")])
 def test_keywords_are_not_names(name: str, legal: str) -> None:
-    assert kuka.legal_name(name) == legal
-    assert kuka.is_legal_name(legal) and (name == legal or not kuka.is_legal_name(name))
+    assert NAME_RULE.legal(name) == legal
+    assert NAME_RULE.is_legal(legal) and (name == legal or not NAME_RULE.is_legal(name))
 
 
 @pytest.mark.parametrize(

@@ -11,7 +11,7 @@ import pytest
 
 import olp
 from olp.errors import PostError, UsageError
-from olp.post import find_post
+from olp.posts import find_post
 
 REPO = Path(__file__).resolve().parents[2]
 CELL = REPO / "stations" / "kr6_milling_cell.yaml"
@@ -35,8 +35,8 @@ def test_a_folder_named_like_a_bundled_post_does_not_replace_it(
 ) -> None:
     _hostile_copy(tmp_path / "kuka", "; HIJACKED")
     monkeypatch.chdir(tmp_path)
-    manifest = find_post("kuka")
-    assert manifest.folder.resolve() == BUNDLED_KUKA.resolve()
+    post = find_post("kuka")
+    assert post.manifest.folder.resolve() == BUNDLED_KUKA.resolve()
     result = olp.build(olp.load_station(CELL), MILLING, post="kuka")
     assert "HIJACKED" not in result.files["Milling.src"]
 

@@ -7,6 +7,8 @@ import pytest
 
 from olp import ir
 from olp.passes.resolve import Step
+from olp.posts.abb import NAME_RULE as ABB_NAMES
+from olp.posts.kuka import NAME_RULE as KUKA_NAMES
 from olp.transforms.split import (
     SplitLimits,
     part_names,
@@ -14,7 +16,6 @@ from olp.transforms.split import (
     split_program,
     split_steps,
 )
-from olp.vendors import abb, kuka
 
 M, X = True, False  # a motion, another instruction
 
@@ -56,16 +57,16 @@ def test_limits_must_be_positive_integers(bad: object) -> None:
 
 
 def test_part_names_are_numbered_padded_and_legal() -> None:
-    assert part_names("Milling", 3, kuka.legal_name, kuka.MAX_NAME_LENGTH) == [
+    assert part_names("Milling", 3, KUKA_NAMES.legal, KUKA_NAMES.max_length) == [
         "Milling_P1",
         "Milling_P2",
         "Milling_P3",
     ]
-    names = part_names("Milling", 12, kuka.legal_name, kuka.MAX_NAME_LENGTH)
+    names = part_names("Milling", 12, KUKA_NAMES.legal, KUKA_NAMES.max_length)
     assert names[0] == "Milling_P01" and names[-1] == "Milling_P12"
 
 
-@pytest.mark.parametrize(("legal", "limit"), [(kuka.legal_name, 24), (abb.legal_name, 32)])
+@pytest.mark.parametrize(("legal", "limit"), [(KUKA_NAMES.legal, 24), (ABB_NAMES.legal, 32)])
 def test_long_names_are_cut_to_fit_the_suffix(legal: object, limit: int) -> None:
     name = "A_very_long_program_name_for_a_milling_job"
     names = part_names(name, 150, legal, limit)  # type: ignore[arg-type]
@@ -77,7 +78,7 @@ def test_long_names_are_cut_to_fit_the_suffix(legal: object, limit: int) -> None
 def test_part_names_never_clash_with_the_main_ignoring_case() -> None:
     # The main name, cut to 24 characters, ends like part 1 would: the part must differ.
     main = "ABCDEFGHIJKLMNOPQRSTU_P1"
-    names = part_names(main, 2, kuka.legal_name, 24)
+    names = part_names(main, 2, KUKA_NAMES.legal, 24)
     assert main.casefold() not in {n.casefold() for n in names}
     assert len({n.casefold() for n in names}) == 2 and all(len(n) <= 24 for n in names)
 
@@ -93,7 +94,7 @@ def _moves(n: int) -> list[ir.Instruction]:
 
 def test_split_program_is_ir_to_ir() -> None:
     program = ir.Program(name="Job", instructions=tuple(_moves(5)), source="job.src")
-    main, parts = split_program(program, SplitLimits(max_motions=2), kuka.legal_name, 24)
+    main, parts = split_program(program, SplitLimits(max_motions=2), KUKA_NAMES.legal, 24)
     assert [p.name for p in parts] == ["Job_P1", "Job_P2", "Job_P3"]
     assert [i.name for i in main.instructions] == ["Job_P1", "Job_P2", "Job_P3"]  # type: ignore[union-attr]
     joined = tuple(i for p in parts for i in p.instructions)

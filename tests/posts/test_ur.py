@@ -47,7 +47,9 @@ from olp.ir import (
     is_motion,
 )
 from olp.passes.resolve import CompiledProgram, Step
-from olp.post import find_post, render
+from olp.posts import find_post
+from olp.posts.base import Post
+from olp.posts.ur import MAX_MOTIONS, ur_joints
 from olp.station.model import Station
 from olp.transforms.blend import cap_blends, capped_radii
 from olp.vendors import ur
@@ -66,6 +68,19 @@ PI = math.pi
 @cache
 def _station(path: Path = UR_CELL) -> Station:
     return olp.load_station(path)
+
+
+def render(compiled: CompiledProgram, post: Post, name: str | None = None) -> dict[str, str]:
+    """The post's files (its transforms applied)."""
+    return post.render(compiled, name)
+
+
+def post_diagnostics(compiled: CompiledProgram, post: Post | None = None) -> list[Diagnostic]:
+    """What the post reports (URScript by default): its transforms' diagnostics, then its
+    checks."""
+    post = post or find_post("ur")
+    prepared, found = post.prepare(compiled)
+    return found + post.check(prepared)
 
 
 def _build(station: Station, program: Any, **kw: Any) -> Any:
@@ -161,7 +176,9 @@ ROWS: dict[str, tuple[list[tuple[Instruction, Any]], list[str]]] = {
         [(JointMove(target=CartesianTarget(pose=TOOL_DOWN)), _plan(TOOL_DOWN))],
         [
             "  set_tcp(p[0.000000, 0.000000, 0.000000, 0.000000, 0.000000, 0.000000])",
-            "  movej(" + ur.ur_joints(_plan(TOOL_DOWN)) + ", a=1.40000, v=3.14159, r=0.000000)",
+            "  movej("
+            + ur_joints(find_post("ur"), _plan(TOOL_DOWN))
+            + ", a=1.40000, v=3.14159, r=0.000000)",
         ],
     ),
     "movel: the TCP in UR's Base frame, m and rotation vector, v in m/s": (
@@ -227,7 +244,8 @@ ROWS: dict[str, tuple[list[tuple[Instruction, Any]], list[str]]] = {
             "  end",
             "  SprayOn()",
             '  tcp_on(1, "cup A", -2.5)',
-            "  # approach the part",
+            "  # approach",
+            "  # the part",
         ],
     ),
 }
@@ -320,7 +338,7 @@ def test_capping_reports_a_located_warning_per_reduced_radius() -> None:
     assert radii == pytest.approx([0.015, 0.015, 0.015, 0.02, 0.0], abs=1e-12)
     assert [s.instruction.zone.radius for s in capped.steps] == radii
     assert cap_blends(capped)[1] == []  # capping is idempotent
-    ur_diags = ur.post_diagnostics(compiled)
+    ur_diags = post_diagnostics(compiled)
     assert [d.kind for d in ur_diags] == ["blend_capped"] * 5
 
 
@@ -363,29 +381,31 @@ def _kinds(diags: list[Diagnostic]) -> list[tuple[str, str]]:
         (SetOutput(index=10, value=True), [("error", "io_range")]),
         (WaitInput(index=-1), [("error", "io_range")]),
         (SetOutput(index=9, value=True), []),
-        (Call(name="spray on"), [("error", "bad_call")]),
-        (Call(name="def"), [("error", "bad_call")]),
-        (Call(name="Spray", args=("TRUE",)), [("error", "bad_call")]),
+        (Call(name="spray on"), [("error", "call_name")]),
+        (Call(name="def"), [("error", "call_name")]),
+        (Call(name="Spray", args=("TRUE",)), [("error", "call_argument")]),
         (Call(name="Spray", args=("1.5e3", '"x"')), []),
     ],
 )
 def test_instruction_diagnostics(instruction: Instruction, expected: list[tuple[str, str]]) -> None:
-    assert _kinds(ur.post_diagnostics(_compiled([(instruction, None)]))) == expected
+    assert _kinds(post_diagnostics(_compiled([(instruction, None)]))) == expected
 
 
 def test_a_robot_of_another_brand_is_a_warning() -> None:
     kuka = _station(KUKA_CELL)
     move = JointMove(target=JointTarget(joints=kuka.robot.home))
-    diags = ur.post_diagnostics(_compiled([(move, kuka.robot.home)], kuka))
+    diags = post_diagnostics(_compiled([(move, kuka.robot.home)], kuka))
     assert _kinds(diags) == [("warning", "foreign_robot")]
     assert "KUKA KR 6 R900 sixx" in diags[0].message
 
 
 def test_a_long_script_is_a_warning() -> None:
     move = JointMove(target=JointTarget(joints=HOME))
-    diags = ur.post_diagnostics(_compiled([(move, HOME)] * (ur.MAX_MOTIONS + 1)))
+    diags = post_diagnostics(_compiled([(move, HOME)] * (MAX_MOTIONS + 1)))
     assert _kinds(diags) == [("warning", "program_too_long")]
-    assert not find_post("ur").limits.active  # one script cannot call another: no splitting
+    assert not find_post(
+        "ur"
+    ).manifest.limits.active  # one script cannot call another: no splitting
 
 
 def test_an_error_blocks_the_build_and_writes_nothing(tmp_path: Path) -> None:

@@ -15,6 +15,8 @@ from olp import geometry as g
 from olp import vendors
 from olp.ir import Configuration
 from olp.kinematics import opw
+from olp.posts import find_post
+from olp.posts.abb import NAME_RULE, rapid_confdata, rapid_jointtarget, rapid_pose, rapid_robtarget
 from olp.vendors import abb
 
 DEG = math.pi / 180.0
@@ -63,7 +65,7 @@ def test_quaternion_special_cases(rotation: np.ndarray, expected: list[float]) -
 def test_tool_down_robtarget_orientation_is_0_0_1_0() -> None:
     """The orientation that RAPID programs carry for a tool pointing down with X back."""
     pose = g.transl(0.5, 0.0, 0.3) @ g.roty(math.pi)
-    assert abb.rapid_pose(pose) == (
+    assert rapid_pose(find_post("abb"), pose) == (
         "[[500.000,0.000,300.000],[0.000000000,0.000000000,1.000000000,0.000000000]]"
     )
 
@@ -178,7 +180,7 @@ def test_irb120_calibration_position() -> None:
     assert np.allclose(trans, [374.0, 0.0, 630.0], atol=1e-9)
     assert np.allclose(abb.normalised_rounded(rot, 7), [0.7071068, 0, 0.7071068, 0], atol=0)
     assert abb.confdata(IRB120, np.zeros(6)).tolist() == [0, 0, 0, 0]
-    assert abb.rapid_robtarget(pose, [0, 0, 0, 0]) == (
+    assert rapid_robtarget(find_post("abb"), pose, [0, 0, 0, 0]) == (
         "[[374.000,0.000,630.000],[0.707106781,0.000000000,0.707106781,0.000000000],"
         "[0,0,0,0],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]]"
     )
@@ -296,14 +298,14 @@ def test_configuration_from_confdata_type() -> None:
 
 
 def test_jointtarget_spelling() -> None:
-    assert abb.rapid_jointtarget(np.radians([0, -0.000001, 30, 0, 90, -400])) == (
+    assert rapid_jointtarget(find_post("abb"), np.radians([0, -0.000001, 30, 0, 90, -400])) == (
         "[[0.00000,0.00000,30.00000,0.00000,90.00000,-400.00000],"
         "[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]]"
     )
 
 
 def test_confdata_spelling() -> None:
-    assert abb.rapid_confdata([-1, 0, -2, 5]) == "[-1,0,-2,5]"
+    assert rapid_confdata([-1, 0, -2, 5]) == "[-1,0,-2,5]"
 
 
 @pytest.mark.parametrize(
@@ -320,4 +322,4 @@ def test_confdata_spelling() -> None:
     ],
 )
 def test_legal_name(name: str, legal: str) -> None:
-    assert abb.legal_name(name) == legal
+    assert NAME_RULE.legal(name) == legal

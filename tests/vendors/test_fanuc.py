@@ -17,6 +17,8 @@ from olp.kinematics import opw
 from olp.kinematics.base import FANUC_J2_J3, JointCoupling
 from olp.kinematics.configuration import satisfies
 from olp.kinematics.models import OPWKinematics
+from olp.posts import find_post
+from olp.posts.fanuc import NAME_RULE, ls_joints, ls_xyzwpr
 from olp.vendors import fanuc
 
 DEG = math.pi / 180.0
@@ -264,13 +266,20 @@ def test_flange_is_tool0() -> None:
     ],
 )
 def test_legal_name(name: str, legal: str) -> None:
-    assert fanuc.legal_name(name) == legal
+    assert NAME_RULE.legal(name) == legal
 
 
 def test_ls_numbers_have_no_negative_zero() -> None:
     pose = fanuc.xyzwpr_to_pose([-0.0000001, 1.5, -2.25, -180, 0, 0])
-    assert fanuc.ls_xyzwpr(pose) == ["0.000", "1.500", "-2.250", "180.000", "0.000", "0.000"]
-    assert fanuc.ls_joints(np.radians([0, -1e-7, 30, 0, -90, 0])) == [
+    assert ls_xyzwpr(find_post("fanuc"), pose) == [
+        "0.000",
+        "1.500",
+        "-2.250",
+        "180.000",
+        "0.000",
+        "0.000",
+    ]
+    assert ls_joints(find_post("fanuc"), np.radians([0, -1e-7, 30, 0, -90, 0])) == [
         "0.000",
         "0.000",
         "30.000",

@@ -6,6 +6,8 @@ import numpy as np
 import pytest
 
 from olp import geometry as g
+from olp.posts import find_post
+from olp.posts.kuka import NAME_RULE, krl_axis, krl_frame
 from olp.vendors import kuka
 
 
@@ -82,12 +84,12 @@ def test_turn_bits() -> None:
 
 
 def test_krl_frame_spelling_has_no_negative_zero() -> None:
-    text = kuka.krl_frame(kuka.frame_to_pose([-0.0000001, 1.5, -2.25, -180, 0, -180]))
+    text = krl_frame(find_post("kuka"), kuka.frame_to_pose([-0.0000001, 1.5, -2.25, -180, 0, -180]))
     assert text == "X 0.000,Y 1.500,Z -2.250,A 180.0000,B 0.0000,C 180.0000"
 
 
 def test_krl_axis_spelling() -> None:
-    assert kuka.krl_axis(np.radians([0, -90, 90, 0, 0, 0.5])) == (
+    assert krl_axis(find_post("kuka"), np.radians([0, -90, 90, 0, 0, 0.5])) == (
         "A1 0.00000,A2 -90.00000,A3 90.00000,A4 0.00000,A5 0.00000,A6 0.50000"
     )
 
@@ -103,4 +105,4 @@ def test_krl_axis_spelling() -> None:
     ],
 )
 def test_legal_name(name: str, legal: str) -> None:
-    assert kuka.legal_name(name) == legal
+    assert NAME_RULE.legal(name) == legal

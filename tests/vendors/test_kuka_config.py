@@ -66,9 +66,9 @@ def test_status_from_params_is_status_bits_with_the_geometry() -> None:
     assert np.array_equal(kuka.status_from_joints(KR6, q), explicit)
 
 
-def test_krl_spelling() -> None:
-    assert kuka.krl_status_turn(np.radians([0, -90, 90, 0, -90, -5]), KR6) == "S 6,T 50"
-    assert "krl_status_turn" in kuka.TEMPLATE_FILTERS
+def test_status_and_turn_of_a_tool_down_pose() -> None:
+    status, turn = kuka.status_turn(KR6, np.radians([0, -90, 90, 0, -90, -5]))
+    assert (int(status), int(turn)) == (6, 50)
 
 
 @pytest.mark.parametrize(

@@ -13,6 +13,8 @@ from scipy.spatial.transform import Rotation
 
 from olp import geometry as g
 from olp import vendors
+from olp.posts import find_post
+from olp.posts.ur import NAME_RULE, ur_joints, ur_pose
 from olp.vendors import ur
 
 H = math.sqrt(0.5)
@@ -98,11 +100,14 @@ def test_pose_values_are_metres_and_radians() -> None:
 
 def test_pose_spelling() -> None:
     pose = g.transl(0.1, -0.0000001, 0.3) @ g.roty(-math.pi)
-    assert ur.ur_pose(pose) == "p[0.100000, 0.000000, 0.300000, 0.000000, 3.141593, 0.000000]"
+    assert (
+        ur_pose(find_post("ur"), pose)
+        == "p[0.100000, 0.000000, 0.300000, 0.000000, 3.141593, 0.000000]"
+    )
 
 
 def test_joint_spelling() -> None:
-    assert ur.ur_joints([0, -math.pi / 2, 1e-9, 0, math.pi, -1]) == (
+    assert ur_joints(find_post("ur"), [0, -math.pi / 2, 1e-9, 0, math.pi, -1]) == (
         "[0.000000, -1.570796, 0.000000, 0.000000, 3.141593, -1.000000]"
     )
 
@@ -118,4 +123,4 @@ def test_flange_is_tool0_and_there_is_no_configuration() -> None:
     [("Pick1", "Pick1"), ("my prog-1", "my_prog_1"), ("1st", "p1st"), ("def", "def_"), ("", "p")],
 )
 def test_legal_name(name: str, legal: str) -> None:
-    assert ur.legal_name(name) == legal
+    assert NAME_RULE.legal(name) == legal

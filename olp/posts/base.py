@@ -1,0 +1,367 @@
+"""The base of every post: the shared checks, the escaping of user text, number checks, shared
+filters and IR rewrites; a brand (:mod:`olp.posts.kuka`, ...) states only what differs.
+
+In the spirit of sqlglot's dialect generators, a post is a class whose tables say what its
+language is like, spread from the base::
+
+    class KukaPost(Post):
+        VENDOR = "kuka"
+        NAME_RULE = NameRule(max_length=24, reserved=KEYWORDS)
+        IO_RANGE = (1, 4096)
+        NUMBERS = {**Post.NUMBERS, "vel_cp": NumberFormat(...)}
+        FILTERS = {**Post.FILTERS, "krl_frame": lambda post, pose: ...}
+
+and its templates (``posts/<name>/``) say how a program is spelled. A build runs
+:meth:`Post.prepare` (the ``TRANSFORMS``: IR rewrites the language needs, such as capping blend
+radii), :meth:`Post.check` (what cannot be written, as located diagnostics), then
+:meth:`Post.render`.
+
+What every post checks (:meth:`Post.check`), so that no brand can forget it:
+
+* an instruction kind the post cannot write (``KINDS``) is an error on its line, never a silent
+  drop (kind ``unsupported``);
+* comments (``COMMENTS``): a line break becomes another comment line; another control character,
+  or a character the output encoding lacks, is an error (``comment``);
+* calls: the routine's name must already be legal (``NAME_RULE``; olp never renames what another
+  program defines), each argument must be a literal or a name the language allows
+  (``CALL_ARGUMENTS``): ``Grip(1;MoveAbsJ ...)`` can never write a live move (``call_name``,
+  ``call_argument``);
+* digital I/O numbers within the controller's range (``IO_RANGE``, ``io_range``);
+* a station robot of another brand than the post's (a warning, ``foreign_robot``).
+
+Numbers are written through :meth:`Post.number` with a quantity of ``NUMBERS``
+(:mod:`olp.posts.numbers`): a value the controller cannot hold as checked and timed is an error on
+the instruction being written.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, ClassVar
+
+import numpy as np
+from numpy.typing import NDArray
+
+from olp.diagnostics import Diagnostic
+from olp.errors import PostError
+from olp.posts.numbers import NumberError, NumberFormat, format_number, format_numbers
+from olp.posts.sandbox import PostSandbox, make_environment
+from olp.posts.text import (
+    ArgumentRule,
+    CommentRule,
+    NameRule,
+    basename,
+    encodable,
+    plain,
+    show_character,
+)
+
+if TYPE_CHECKING:
+    from olp.passes.resolve import CompiledProgram, Step
+    from olp.posts.manifest import PostManifest
+    from olp.posts.view import PostStep
+
+FloatArray = NDArray[np.float64]
+
+Filter = Callable[..., Any]
+"""A template filter: ``(post, value, *args) -> value``; the post is bound when the sandbox is
+made, so filters can reach the post's rules, options and number formats."""
+
+Transform = Callable[["CompiledProgram", "Post"], "tuple[CompiledProgram, list[Diagnostic]]"]
+"""An IR rewrite a language needs before rendering, with the diagnostics it gives."""
+
+ALL_KINDS = frozenset(
+    {"joint", "linear", "circular", "wait", "set_output", "wait_input", "call", "comment"}
+)
+"""Instruction kinds of the IR."""
+
+GENERIC_NUMBER = NumberFormat("number", "", 3)
+"""The ``num`` filter's format where a template names no quantity (range: any finite value)."""
+
+
+def _num(post: Post, value: float, decimals: int = 3) -> str:
+    fmt = NumberFormat("number", "", int(decimals))
+    return post.number_with(fmt, value)
+
+
+def _number(post: Post, value: float, quantity: str) -> str:
+    return post.number(quantity, value)
+
+
+def _deg(post: Post, value: float) -> float:
+    return math.degrees(value)
+
+
+def _basename(post: Post, path: str) -> str:
+    """The last component of a path written with ``/`` or ``\\``, escaped for a comment."""
+    return post.plain_text(basename(path))
+
+
+class Post:
+    """A post-processor: rules, checks and filters of one controller language, rendering the
+    templates of one folder (``manifest``). A Post renders one program at a time."""
+
+    NAME: ClassVar[str] = ""
+    """The registry name (``olp build --post NAME``)."""
+    VENDOR: ClassVar[str] = ""
+    """The robot brand whose controllers run this code ("" for a brand-neutral post)."""
+    LANGUAGE: ClassVar[str] = "robot code"
+    """The language, for messages."""
+    NAME_RULE: ClassVar[NameRule] = NameRule()
+    COMMENTS: ClassVar[CommentRule] = CommentRule()
+    CALL_ARGUMENTS: ClassVar[ArgumentRule] = ArgumentRule()
+    IO_RANGE: ClassVar[tuple[int, int] | None] = None
+    """Digital output and input numbers the controller has (None: no numbers are written)."""
+    KINDS: ClassVar[frozenset[str]] = ALL_KINDS
+    """Instruction kinds the templates write."""
+    NUMBERS: ClassVar[Mapping[str, NumberFormat]] = {"number": GENERIC_NUMBER}
+    FILTERS: ClassVar[Mapping[str, Filter]] = {
+        "num": _num,
+        "number": _number,
+        "deg": _deg,
+        "basename": _basename,
+    }
+    TRANSFORMS: ClassVar[tuple[Transform, ...]] = ()
+    NULL_TOOL_NAME: ClassVar[str | None] = None
+    """The controller's own name for no tool (written instead of a generated name)."""
+    NULL_FRAME_NAME: ClassVar[str | None] = None
+    """The controller's own name for its reference frame."""
+    PREDEFINED_NAMES: ClassVar[frozenset[str]] = frozenset()
+    """Names the controller defines: generated data never take them."""
+
+    def __init__(self, manifest: PostManifest) -> None:
+        self.manifest = manifest
+        self.current_step: PostStep | None = None
+        self.problems: list[Diagnostic] = []
+        self.collecting = False
+        """While rendering: numbers that cannot be written are collected as diagnostics on the
+        instruction being written (else :class:`~olp.posts.numbers.NumberError` is raised)."""
+
+    @property
+    def options(self) -> Mapping[str, Any]:
+        return self.manifest.options
+
+    @property
+    def name(self) -> str:
+        return self.manifest.name
+
+    # ----------------------------------------------------------------------------------------
+    # Hooks a brand overrides
+
+    def step_values(self, robot: Any, joints: FloatArray) -> list[Mapping[str, Any]]:
+        """Per motion, from its planned joints ``(N, dof)`` rad: values the templates need
+        (KUKA Status/Turn, ABB confdata), as ``PostStep.vendor``."""
+        return [{} for _ in range(joints.shape[0])]
+
+    def context_values(self, steps: Sequence[PostStep]) -> Mapping[str, Any]:
+        """Per file: the ``vendor`` context entry (e.g. ABB's custom speed data)."""
+        return {}
+
+    def check_instruction(self, step: Step, compiled: CompiledProgram) -> list[Diagnostic]:
+        """What this language cannot say exactly about one instruction."""
+        return []
+
+    def check_program(self, compiled: CompiledProgram) -> list[Diagnostic]:
+        """What this language cannot say exactly about the whole program."""
+        return []
+
+    # ----------------------------------------------------------------------------------------
+    # The pipeline
+
+    def prepare(self, compiled: CompiledProgram) -> tuple[CompiledProgram, list[Diagnostic]]:
+        """Apply the ``TRANSFORMS`` in order."""
+        found: list[Diagnostic] = []
+        for transform in self.TRANSFORMS:
+            compiled, more = transform(compiled, self)
+            found += more
+        return compiled, found
+
+    def check(self, compiled: CompiledProgram) -> list[Diagnostic]:
+        """Everything this post reports about ``compiled``; errors mean nothing is written."""
+        out = self._foreign_robot(compiled)
+        for step in compiled.steps:
+            out += self._shared_checks(step)
+            out += self.check_instruction(step, compiled)
+        return out + self.check_program(compiled)
+
+    def render(self, compiled: CompiledProgram, name: str | None = None) -> dict[str, str]:
+        """Every file of the program (:func:`olp.posts.render.render`), after the
+        ``TRANSFORMS`` (which are idempotent: a program :meth:`prepare` already rewrote stays as
+        it is), so the text never depends on whether the caller prepared the program."""
+        from olp.posts.render import render
+
+        return render(self.prepare(compiled)[0], self, name)
+
+    def write(self, files: Mapping[str, str], folder: Path) -> list[Path]:
+        """Encode every file in the manifest's encoding (a character it lacks is a PostError
+        naming the file, line and column: :meth:`check` should have reported it on its source
+        line already), then write them as one set into ``folder``
+        (:func:`olp.output.write_folder`: all or nothing, stale parts of an earlier build
+        removed)."""
+        from olp.output import write_folder
+
+        encoding = self.manifest.encoding
+        encoded = {}
+        for fname, text in files.items():
+            try:
+                encoded[fname] = text.encode(encoding)
+            except UnicodeEncodeError as exc:
+                bad = text[exc.start : exc.end]
+                line = text.count("\n", 0, exc.start) + 1
+                column = exc.start - (text.rfind("\n", 0, exc.start) + 1) + 1
+                raise PostError(
+                    f"{fname}:{line}:{column}: character {bad!r} cannot be written in {encoding}"
+                ) from exc
+        return write_folder(encoded, folder)
+
+    def environment(self) -> PostSandbox:
+        """The sandboxed Jinja environment of this post's folder, with its filters bound."""
+        filters = {name: _bind(fn, self) for name, fn in self.FILTERS.items()}
+        return make_environment(self.manifest.folder, filters)
+
+    # ----------------------------------------------------------------------------------------
+    # Numbers and text
+
+    def number(self, quantity: str, value: float) -> str:
+        """``value`` in the printed unit of ``quantity`` (``NUMBERS``), checked; a value that
+        cannot be written becomes an error on the instruction being written."""
+        return self.number_with(self.NUMBERS[quantity], value)
+
+    def numbers(self, quantity: str, values: Any) -> list[str]:
+        """:meth:`number` for an array of values (N,)."""
+        try:
+            return format_numbers(values, self.NUMBERS[quantity])
+        except NumberError as exc:
+            self._refuse(str(exc))
+            return ["?"] * int(np.size(values))
+
+    def number_with(self, fmt: NumberFormat, value: float) -> str:
+        try:
+            return format_number(value, fmt)
+        except NumberError as exc:
+            self._refuse(str(exc))
+            return "?"
+
+    def _refuse(self, message: str) -> None:
+        if not self.collecting:
+            raise NumberError(message)
+        step = self.current_step
+        span = step.instruction.span if step is not None else None
+        index = step.index if step is not None else None
+        self.problems.append(Diagnostic("error", "number", message, span, index))
+
+    def comment_lines(self, text: str) -> tuple[str, ...]:
+        """A comment's lines as this language writes them (checked by :meth:`check`)."""
+        return tuple(self.COMMENTS.lines(text))
+
+    def plain_text(self, text: str) -> str:
+        """Informational text (a file name in a header comment): control characters and
+        characters the output encoding lacks become ``?``."""
+        return plain(text, self.manifest.encoding)
+
+    # ----------------------------------------------------------------------------------------
+    # Shared checks
+
+    def _foreign_robot(self, compiled: CompiledProgram) -> list[Diagnostic]:
+        robot = compiled.station.robot
+        if not self.VENDOR or robot.vendor == self.VENDOR:
+            return []
+        return [
+            Diagnostic(
+                "warning",
+                "foreign_robot",
+                f"the station's robot is a {robot.name} ({robot.vendor}): the {self.LANGUAGE} "
+                "written holds that robot's joints and poses",
+                hint=f"to run it, compile on a station with a {self.VENDOR} robot",
+            )
+        ]
+
+    def _shared_checks(self, step: Step) -> list[Diagnostic]:
+        ins: Any = step.instruction
+        kind = ins.kind
+        if kind not in self.KINDS:
+            msg = f"the {self.LANGUAGE} post cannot write a {kind.replace('_', ' ')} instruction"
+            return [_error("unsupported", msg, step)]
+        if kind == "comment":
+            return self._comment_checks(step, ins.text)
+        if kind == "call":
+            return self._call_checks(step, ins.name, ins.args)
+        if kind in ("set_output", "wait_input"):
+            return self._io_checks(step, kind, ins.index)
+        return []
+
+    def _comment_checks(self, step: Step, text: str) -> list[Diagnostic]:
+        try:
+            lines = self.COMMENTS.lines(text)
+        except ValueError as exc:
+            return [_error("comment", f"comment holds a {exc}: it cannot be written", step)]
+        return self._encoding_checks(step, "comment", "\n".join(lines))
+
+    def _call_checks(self, step: Step, name: str, args: Sequence[str]) -> list[Diagnostic]:
+        if not self.NAME_RULE.is_legal(name):
+            msg = f"call of {_quote(name)}: not a legal {self.LANGUAGE} routine name"
+            return [_error("call_name", msg, step, hint=self._name_hint())]
+        for arg in args:
+            if not self.CALL_ARGUMENTS.allows(arg):
+                msg = (
+                    f"call of {name}: argument {_quote(arg)} cannot be written in "
+                    f"{self.LANGUAGE} (allowed: {self.CALL_ARGUMENTS.describe})"
+                )
+                return [_error("call_argument", msg, step)]
+        return self._encoding_checks(step, "call", ",".join(args))
+
+    def _name_hint(self) -> str:
+        rule = self.NAME_RULE
+        length = f", at most {rule.max_length} characters" if rule.max_length else ""
+        return f"letters, digits and _, a letter first{length}, not a reserved word"
+
+    @property
+    def io_range(self) -> tuple[int, int] | None:
+        """``IO_RANGE``, or the template folder's option ``io_range: [low, high]`` (a cell
+        whose controller has more or fewer I/O than the class assumes)."""
+        given = self.options.get("io_range")
+        if given is None:
+            return self.IO_RANGE
+        low, high = (int(v) for v in given)
+        return low, high
+
+    def _io_checks(self, step: Step, kind: str, index: int) -> list[Diagnostic]:
+        span = self.io_range
+        if span is None or span[0] <= index <= span[1]:
+            return []
+        what = "output" if kind == "set_output" else "input"
+        msg = (
+            f"digital {what} {index} is outside the {self.LANGUAGE} controller's range "
+            f"{span[0]}..{span[1]}"
+        )
+        return [_error("io_range", msg, step)]
+
+    def _encoding_checks(self, step: Step, what: str, text: str) -> list[Diagnostic]:
+        bad = encodable(text, self.manifest.encoding)
+        if bad is None:
+            return []
+        msg = (
+            f"{what} holds the character {show_character(bad)}, which a "
+            f"{self.manifest.encoding} {self.LANGUAGE} file cannot hold"
+        )
+        return [_error(what, msg, step)]
+
+
+def _bind(fn: Filter, post: Post) -> Filter:
+    def bound(*args: Any, **kwargs: Any) -> Any:
+        return fn(post, *args, **kwargs)
+
+    bound.__name__ = getattr(fn, "__name__", "filter")
+    bound.__doc__ = fn.__doc__
+    return bound
+
+
+def _error(kind: str, message: str, step: Step, hint: str | None = None) -> Diagnostic:
+    return Diagnostic("error", kind, message, step.instruction.span, step.index, hint=hint)
+
+
+def _quote(text: str, limit: int = 60) -> str:
+    shown = text if len(text) <= limit else text[: limit - 3] + "..."
+    return repr(shown)

@@ -1,0 +1,462 @@
+"""The LS post (Fanuc R-30iB): TP programs as LS text, ``NAME.ls``.
+
+Conventions shared with frontends (W, P, R; CONFIG and turn numbers; the J2/J3 coupling; what
+CONFIG can select) live in :mod:`olp.vendors.fanuc`; this module is how the post spells them.
+Pinned by ``tests/posts/test_fanuc.py``, the cross-post table and the golden files
+``tests/golden/fanuc/``.
+
+Layout as in LS files exported by R-30iB controllers and ROBOGUIDE (public backups; the
+project vendor notes): ``/PROG  NAME``, ``/ATTR``, ``/MN``, ``/POS``, ``/END``; CRLF line
+endings (the files are DOS text; medium confidence that LF would also do).
+
+* ``/ATTR``: olp writes the fields exported files carry except the dates, sizes and file name
+  the controller fills in (``CREATE``/``MODIFIED`` are left out so that the bytes do not depend
+  on the clock; whether MakeTP requires them is unverified), ``LINE_COUNT`` = numbered /MN
+  lines, ``DEFAULT_GROUP = 1,*,*,*,*`` (one robot, group 1).
+* ``/MN``: ``%4d:`` line numbers from 1 (:func:`number_lines`); motion lines ``J P[1] 100%
+  FINE    ;``, other lines ``  DO[1]=ON ;``; a circular move is ``C P[via]`` and, on a
+  continuation line ``    :  P[end] 100mm/sec FINE    ;``, one program line.
+* Speeds: ``J`` in percent of each axis' maximum, ``Speed.joint`` rounded half up to an integer
+  1..100 (:func:`joint_percent`); ``L``/``C`` in integer mm/sec, ``Speed.linear`` rounded half
+  up, at least 1 (:func:`linear_mm_per_s`; the pendant takes integers there, medium
+  confidence; 21.17 mm/s becomes 21mm/sec).
+* Termination (:func:`termination`): a zone of radius 0 is ``FINE``; any other is ``CNTn`` with
+  ``n = round(radius in mm)`` capped at 100, the rule of RoboDK's public Fanuc post
+  (``setZoneData``: ``'CNT%i' % round(min(zone_mm, 100))``; olp rounds halves up). It is not
+  exact: ``CNT`` is a percentage of corner rounding whose path depends on speed and
+  acceleration, not a distance.
+* ``UFRAME_NUM``/``UTOOL_NUM`` before each file's first motion and wherever they change; every
+  position records the ``UF``/``UT`` it was taught in (the controller refuses a mismatch).
+
+  - Frames (:func:`uframe_number`): a frame numbered 1..9 (R-30iB user frames, medium
+    confidence) is ``UF n``; positions are then relative to it, and the controller's
+    ``UFRAME[n]`` must hold the station's frame in World (an info diagnostic gives the values).
+    Every other frame (number 0, the station's world, or none, e.g. a KRL inline ``$BASE``) is
+    written as ``UF 0`` with the positions in Fanuc's World frame (the post's ``frames_in:
+    robot_base``: the robot's ``base · controller_base``, at J2 height for Fanuc arms): exact,
+    nothing to set up.
+  - Tools (:func:`utool_number`): a tool numbered 0..10 is ``UT n`` (``UT 0``: the faceplate,
+    seen in controller exports as ``UTOOL_NUM=0``; 1..10 R-30iB tool frames, medium
+    confidence). An unnumbered tool whose TCP is the faceplate is ``UT 0``; any other unnumbered
+    tool is the post option ``default_utool`` (1), with a warning that gives the TCP the
+    controller's ``UTOOL[n]`` must hold; two such tools, or one whose default number another
+    tool of the program has, are an error.
+
+* Positions (:func:`ls_moves`): ``P[n]`` numbered in order of use in each file (a circle's via
+  point before its end). A Cartesian target of an OPW arm is written as ``X, Y, Z`` (mm),
+  ``W, P, R`` (deg) and the ``CONFIG`` of the planned joints (:func:`config_from_joints`), but
+  only where that CONFIG selects the planned joints and no other IK solution within the limits
+  (:func:`selecting_configs`, the post hook :func:`step_values`; not e.g. when J3 and J3 ± 360°
+  both fit, or at a wrist singularity); otherwise, for joint targets and for arms without
+  CONFIG (UR, numeric), as ``J1..J6`` (deg, the controller's joint convention), with an info
+  diagnostic for a Cartesian target. Values: ``X = %9.3f  mm``, ``J1=%10.3f deg`` (the widths
+  of exported files; they write ``-.000`` where olp writes ``0.000``).
+* ``DO[n]=ON/OFF``, ``WAIT DI[n]=ON/OFF``, ``WAIT 1.00(sec)`` (2 decimals), ``CALL NAME`` or
+  ``CALL NAME(1,2.5)`` (numeric arguments only), ``!comment ;`` lines of at most
+  :data:`COMMENT_LENGTH` characters (longer comments are wrapped over several lines, a line
+  break of the text starts another comment line, ``;`` becomes ``,``; the TP+ compiler writes
+  comments in pieces of about 31 characters). I/O numbers 1..4096 (:data:`IO_RANGE`: the start
+  at 1 is certain, the end is unverified; a template folder may set the option ``io_range``).
+* Numbers: positions and frames are 32-bit REALs on the controller (medium confidence), held to
+  0.01 mm; J speeds 1..100 %, CNT 0..100, integer mm/sec >= 1.
+* Long programs are split (:mod:`olp.transforms.split`, the manifest's ``limits``) into parts
+  ``NAME_P1`` ... and a main program of ``CALL`` lines. The bound is RoboDK's public Fanuc post
+  default of 9999 lines per program (``MAX_LINES_X_PROG``; not a documented Fanuc figure),
+  applied as 3000 instructions per file: an instruction takes at most three /MN lines
+  (``UFRAME_NUM``, ``UTOOL_NUM``, the motion) unless it is a long comment.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, ClassVar
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from olp.diagnostics import Diagnostic
+from olp.geometry import inv
+from olp.posts.base import Filter, Post
+from olp.posts.numbers import NumberError, NumberFormat, Storage
+from olp.posts.sandbox import SafeText
+from olp.posts.text import ArgumentRule, CommentRule, NameRule
+from olp.vendors.fanuc import (
+    candidates,
+    config_from_joints,
+    has_config,
+    pose_to_xyzwpr,
+    selecting_configs,
+)
+
+if TYPE_CHECKING:
+    from olp.passes.resolve import CompiledProgram
+    from olp.posts.view import PostStep
+
+FloatArray = NDArray[np.float64]
+
+MAX_NAME_LENGTH = 36
+"""Program names: 1-36 characters (medium confidence; older controllers accept 8)."""
+
+NAME_RULE = NameRule(max_length=MAX_NAME_LENGTH, upper=True)
+"""A legal program name: upper case A-Z, 0-9 and ``_``, a letter first (``P`` is put in front
+otherwise), at most 36 characters."""
+
+UFRAME_RANGE = (1, 9)
+"""User frames a program may select besides World (0) (R-30iB default; medium confidence)."""
+UTOOL_RANGE = (0, 10)
+"""Tool frames: 0 the faceplate, 1..10 taught tools (medium confidence)."""
+DEFAULT_UTOOL = 1
+"""``UT`` of a tool without a number (the post option ``default_utool`` overrides it)."""
+COMMENT_LENGTH = 32
+"""Characters per ``!`` comment line olp writes (a conservative bound; unverified)."""
+
+_REAL: Storage = "real32"
+
+NUMBERS: Mapping[str, NumberFormat] = {
+    **Post.NUMBERS,
+    "position": NumberFormat("position", "mm", 3, storage=_REAL, resolution=0.01),
+    "angle": NumberFormat("angle", "deg", 3, storage=_REAL, resolution=0.001),
+    "joint_percent": NumberFormat("J speed", "%", 0, 1, 100, storage="int"),
+    "linear": NumberFormat("L/C speed", "mm/sec", 0, low=1, storage="int"),
+    "cnt": NumberFormat("CNT", "", 0, 0, 100, storage="int"),
+    "wait": NumberFormat("WAIT", "s", 2, low=0.0, storage=_REAL, resolution=0.01),
+}
+"""How the LS post writes each quantity (printed units)."""
+
+
+# --------------------------------------------------------------------------------------------
+# Spelling
+
+
+def ls_xyzwpr(post: Post, pose: ArrayLike) -> list[str]:
+    """X, Y, Z (mm) and W, P, R (deg) of a pose (4, 4) in metres as 6 strings (3 decimals)."""
+    v = pose_to_xyzwpr(pose)
+    return [post.number("position", x) for x in v[:3]] + [post.number("angle", x) for x in v[3:]]
+
+
+def ls_joints(post: Post, joints: ArrayLike) -> list[str]:
+    """J1..J6 in degrees (3 decimals) from controller joints (6,) in rad."""
+    return [post.number("angle", v) for v in np.degrees(np.asarray(joints, dtype=np.float64))]
+
+
+def _round_half_up(value: float) -> int:
+    return math.floor(value + 0.5)
+
+
+def joint_percent(post: Post, speed: Any) -> str:
+    """``J`` speed in percent (1..100) of ``speed.joint`` (a fraction of each axis' maximum)."""
+    return post.number("joint_percent", min(100, max(1, _round_half_up(speed.joint * 100.0))))
+
+
+def linear_mm_per_s(post: Post, speed: Any) -> str:
+    """``L``/``C`` speed in integer mm/sec (>= 1) of ``speed.linear`` (m/s)."""
+    return post.number("linear", max(1, _round_half_up(speed.linear * 1000.0)))
+
+
+def termination(post: Post, zone: Any) -> str:
+    """``FINE`` for a zone of radius 0, else ``CNTn``, n = round(radius mm) capped at 100."""
+    if zone.radius <= 0:
+        return "FINE"
+    return "CNT" + post.number("cnt", min(100, _round_half_up(zone.radius * 1000.0)))
+
+
+def wait_seconds(post: Post, seconds: float) -> str:
+    """A ``WAIT`` time: seconds with 2 decimals."""
+    return post.number("wait", seconds)
+
+
+def uframe_number(frame: Any) -> int:
+    """``UF`` of a frame: its number when in 1..9, else 0 (World)."""
+    number = getattr(frame, "number", None)
+    if number is not None and UFRAME_RANGE[0] <= number <= UFRAME_RANGE[1]:
+        return int(number)
+    return 0
+
+
+def is_flange(tool: Any) -> bool:
+    """The tool's TCP is the faceplate itself."""
+    return tool.pose is not None and bool(np.allclose(tool.pose, np.eye(4), rtol=0, atol=1e-12))
+
+
+def utool_number(tool: Any, options: Mapping[str, Any] | None = None) -> int:
+    """``UT`` of a tool: its number; 0 for an unnumbered tool whose TCP is the faceplate; the
+    option ``default_utool`` (:data:`DEFAULT_UTOOL`) for any other unnumbered tool."""
+    if tool.number is not None:
+        return int(tool.number)
+    if is_flange(tool):
+        return 0
+    return int((options or {}).get("default_utool", DEFAULT_UTOOL))
+
+
+def _config_filter(post: Post, joints: ArrayLike, robot: Any) -> str:
+    """Template filter: ``joints | fanuc_config(robot)`` gives ``N U T, 0, 0, 0``."""
+    return str(config_from_joints(robot, joints))
+
+
+# --------------------------------------------------------------------------------------------
+# Positions and program lines
+
+
+@dataclass(frozen=True, slots=True)
+class LsPosition:
+    """One ``P[n]`` of ``/POS``: ``uf``, ``ut``, ``config`` (None: joint representation) and six
+    numbers already spelled (X..R in mm/deg, or J1..J6 in deg)."""
+
+    number: int
+    uf: int
+    ut: int
+    config: str | None
+    values: tuple[str, ...]
+
+    @property
+    def cartesian(self) -> bool:
+        return self.config is not None
+
+
+@dataclass(frozen=True, slots=True)
+class LsMove:
+    """A motion of ``/MN``: its positions, and whether ``UFRAME_NUM``/``UTOOL_NUM`` must be set
+    before it."""
+
+    target: LsPosition
+    via: LsPosition | None = None
+    set_uf: bool = False
+    set_ut: bool = False
+
+
+def ls_moves(
+    post: Post, steps: Sequence[PostStep], robot: Any, options: Mapping[str, Any] | None = None
+) -> dict[int, LsMove]:
+    """Template filter ``steps | ls_moves(robot, options)``: the LS motion of every motion of
+    one file (template view steps, in order), by instruction index. Positions are numbered from
+    1 in each file; ``UFRAME_NUM``/``UTOOL_NUM`` are set before the file's first motion and
+    where they change."""
+    out: dict[int, LsMove] = {}
+    last: tuple[int, int] | None = None
+    number = 0
+    for step in steps:
+        if step.joints is None:
+            continue
+        post.current_step = step
+        uf, ut = uframe_number(step.frame), utool_number(step.tool, options)
+        via = None
+        if step.via is not None:
+            number += 1
+            via = _via_position(post, number, uf, ut, step, robot)
+        number += 1
+        target = _target_position(post, number, uf, ut, step)
+        out[step.index] = LsMove(
+            target, via, last is None or last[0] != uf, last is None or last[1] != ut
+        )
+        last = (uf, ut)
+    post.current_step = None
+    return out
+
+
+def _in_user_frame(step: PostStep, pose_in_frame: ArrayLike, uf: int) -> FloatArray:
+    """A pose given in the step's frame, in the frame ``UF`` positions refer to: the frame
+    itself for UF 1..9, World (the post's ``frames_in: robot_base`` reference) for UF 0."""
+    pose = np.asarray(pose_in_frame, dtype=np.float64)
+    if uf > 0:
+        return pose
+    world: FloatArray = np.asarray(step.frame_pose) @ pose
+    return world
+
+
+def _target_position(post: Post, number: int, uf: int, ut: int, step: PostStep) -> LsPosition:
+    assert step.joints is not None and step.pose is not None
+    config = step.vendor.get("config") if step.cartesian else None
+    if config is None:
+        return LsPosition(number, uf, ut, None, tuple(ls_joints(post, step.joints)))
+    pose = _in_user_frame(step, step.pose, uf)
+    return LsPosition(number, uf, ut, config, tuple(ls_xyzwpr(post, pose)))
+
+
+def _via_position(
+    post: Post, number: int, uf: int, ut: int, step: PostStep, robot: Any
+) -> LsPosition:
+    """A circle's via point with the CONFIG of its IK solution nearest to the end joints (the
+    arc stays in one branch), or the end joints' CONFIG when it has none."""
+    assert step.frame is not None and step.tool is not None and step.via is not None
+    assert step.frame.pose is not None and step.tool.pose is not None
+    joints = np.asarray(step.joints, dtype=np.float64)
+    config = "N U T, 0, 0, 0"
+    if has_config(robot):
+        via_world = np.asarray(step.frame.pose) @ np.asarray(step.via) @ inv(step.tool.pose)
+        found = candidates(robot, via_world)
+        if found.shape[0]:
+            joints = found[np.argmin(np.sum((found - joints) ** 2, axis=-1))]
+        config = str(config_from_joints(robot, joints))
+    pose = _in_user_frame(step, step.via, uf)
+    return LsPosition(number, uf, ut, config, tuple(ls_xyzwpr(post, pose)))
+
+
+def number_lines(post: Post, body: str) -> SafeText:
+    """Number the /MN lines: ``%4d:`` before each line, ``    :`` before a continuation line
+    (one starting with ``:``); empty lines are dropped. The body was rendered from checked
+    pieces, so its lines are safe."""
+    out: list[str] = []
+    count = 0
+    for line in body.splitlines():
+        if not line.strip():
+            continue
+        if line.startswith(":"):
+            out.append("    " + line)
+            continue
+        count += 1
+        out.append(f"{count:4d}:{line}")
+    return SafeText("\n".join(out))
+
+
+def line_count(post: Post, body: str) -> int:
+    """The number of program lines of an un-numbered /MN body (continuations excluded)."""
+    return sum(1 for line in body.splitlines() if line.strip() and not line.startswith(":"))
+
+
+def _xyz_filter(post: Post, value: str) -> str:
+    return f"{value:>9}"
+
+
+def _joint_filter(post: Post, value: str) -> str:
+    return f"{value:>10}"
+
+
+FILTERS: Mapping[str, Filter] = {
+    **Post.FILTERS,
+    "fanuc_config": _config_filter,
+    "ls_xyzwpr": ls_xyzwpr,
+    "ls_joints": ls_joints,
+    "ls_moves": ls_moves,
+    "ls_joint_speed": joint_percent,
+    "ls_linear_speed": linear_mm_per_s,
+    "ls_termination": termination,
+    "ls_seconds": wait_seconds,
+    "ls_number_lines": number_lines,
+    "ls_line_count": line_count,
+    "ls_xyz_field": _xyz_filter,
+    "ls_joint_field": _joint_filter,
+}
+
+
+class FanucPost(Post):
+    """Fanuc R-30iB LS; see the module docstring."""
+
+    NAME = "fanuc"
+    VENDOR = "fanuc"
+    LANGUAGE = "LS"
+    NAME_RULE = NAME_RULE
+    COMMENTS = CommentRule(max_length=COMMENT_LENGTH, replace=((";", ","),), collapse=True)
+    IO_RANGE = (1, 4096)
+    CALL_ARGUMENTS = ArgumentRule(re.compile(r"[+-]?(\d+\.?\d*|\.\d+)"), "numbers")
+    NUMBERS: ClassVar[Mapping[str, NumberFormat]] = NUMBERS
+    FILTERS: ClassVar[Mapping[str, Filter]] = FILTERS
+
+    def step_values(self, robot: Any, joints: Any) -> list[Mapping[str, Any]]:
+        """Per planned motion (joints (N, 6) rad) ``{"config": str | None}``, the CONFIG a
+        Cartesian position gets (:func:`olp.vendors.fanuc.selecting_configs`)."""
+        return [{"config": c} for c in selecting_configs(robot, joints)]
+
+    def check_program(self, compiled: CompiledProgram) -> list[Diagnostic]:
+        """Frame and tool numbers LS cannot write (errors), a tool number olp chose (warning,
+        with the TCP the controller must hold), the controller frames and tools the program
+        relies on (info), Cartesian targets written as joints because no CONFIG selects them
+        alone (info)."""
+        robot = compiled.station.robot
+        motions = [s for s in compiled.steps if s.joints is not None]
+        out = _frame_checks(self, motions, robot)
+        out += _tool_checks(self, motions, self.options)
+        return out + _joint_position_notes(motions, robot)
+
+
+def _first_use(motions: Sequence[Any], attr: str) -> dict[str, Any]:
+    seen: dict[str, Any] = {}
+    for step in motions:
+        seen.setdefault(getattr(step, attr).name, step)
+    return seen
+
+
+def _frame_checks(post: Post, motions: Sequence[Any], robot: Any) -> list[Diagnostic]:
+    out: list[Diagnostic] = []
+    world = np.asarray(robot.base) @ np.asarray(robot.controller_base)
+    for name, step in _first_use(motions, "frame").items():
+        number = step.frame.number
+        if number is not None and number > UFRAME_RANGE[1]:
+            msg = f"frame {name!r} has number {number}: LS user frames are 1..{UFRAME_RANGE[1]}"
+            out.append(_diag("error", "frame_number", msg, step))
+        elif uframe_number(step.frame) > 0:
+            values = _written(post, inv(world) @ np.asarray(step.frame.pose))
+            msg = f"positions use UFRAME[{number}] ({name!r}); the controller must hold it as "
+            out.append(_diag("info", "controller_frame", msg + values, step))
+    return out
+
+
+def _tool_checks(
+    post: Post, motions: Sequence[Any], options: Mapping[str, Any] | None
+) -> list[Diagnostic]:
+    out: list[Diagnostic] = []
+    first = _first_use(motions, "tool")
+    numbered = {t.tool.number for t in first.values() if t.tool.number is not None}
+    unnumbered = [n for n, s in first.items() if s.tool.number is None and not is_flange(s.tool)]
+    for name, step in first.items():
+        number, ut = step.tool.number, utool_number(step.tool, options)
+        values = _written(post, step.tool.pose)
+        if not UTOOL_RANGE[0] <= ut <= UTOOL_RANGE[1]:
+            msg = f"tool {name!r} would be UTOOL {ut}: LS tool frames are 0..{UTOOL_RANGE[1]}"
+            out.append(_diag("error", "tool_number", msg, step))
+        elif number is None and ut > 0 and (len(unnumbered) > 1 or ut in numbered):
+            msg = f"tool {name!r} has no number, and UTOOL {ut} cannot be its: " + (
+                "another tool has that number"
+                if ut in numbered
+                else f"{len(unnumbered)} tools have no number"
+            )
+            out.append(_diag("error", "tool_number", msg, step))
+        elif number is None and ut > 0:
+            msg = f"tool {name!r} has no number: written as UTOOL {ut}, which must hold "
+            out.append(_diag("warning", "tool_number", msg + values, step))
+        elif ut > 0:
+            msg = f"positions use UTOOL[{ut}] ({name!r}); the controller must hold it as "
+            out.append(_diag("info", "controller_tool", msg + values, step))
+    return out
+
+
+def _joint_position_notes(motions: Sequence[Any], robot: Any) -> list[Diagnostic]:
+    """Info per Cartesian target written in joint form (no CONFIG selects it alone)."""
+    cartesian = [s for s in motions if _is_cartesian(s.instruction)]
+    if not cartesian:
+        return []
+    joints = np.stack([np.asarray(s.joints, dtype=np.float64) for s in cartesian])
+    out: list[Diagnostic] = []
+    for step, config in zip(cartesian, selecting_configs(robot, joints), strict=True):
+        if config is None:
+            msg = (
+                "Cartesian target written as joint values: no CONFIG selects the planned "
+                "joints alone (an arm without CONFIG, a wrist singularity, or a J3 range "
+                "holding two turns)"
+            )
+            out.append(_diag("info", "joint_position", msg, step))
+    return out
+
+
+def _is_cartesian(instruction: Any) -> bool:
+    from olp.ir import CartesianTarget
+
+    return isinstance(instruction.target, CartesianTarget)
+
+
+def _written(post: Post, pose: ArrayLike) -> str:
+    """A frame or tool pose as the controller must hold it, in words for a diagnostic."""
+    try:
+        return _spell(ls_xyzwpr(post, pose))
+    except NumberError as exc:
+        return f"(it cannot be written: {exc})"
+
+
+def _spell(values: Sequence[str]) -> str:
+    return " ".join(f"{k} {v}" for k, v in zip("XYZWPR", values, strict=True)) + " (mm, deg)"
+
+
+def _diag(severity: Any, kind: str, message: str, step: Any) -> Diagnostic:
+    return Diagnostic(severity, kind, message, step.instruction.span, step.index)

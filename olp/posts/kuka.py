@@ -1,0 +1,306 @@
+"""The KRL post (KUKA KR C4, KSS 8): a ``.src`` module with its ``.dat`` data list.
+
+Conventions shared with the KRL frontend (ABC angles, Status and Turn, the flange frame) live in
+:mod:`olp.vendors.kuka`; this module is how the post spells them. Pinned by
+``tests/posts/test_kuka.py``, the cross-post table ``tests/posts/test_all_posts.py`` and the golden
+files ``tests/golden/kuka/``.
+
+* Module: ``&ACCESS RVP`` / ``&REL 1`` header, ``DEF name( )`` ... ``END`` in ``name.src`` and
+  ``DEFDAT name PUBLIC`` ... ``ENDDAT`` in ``name.dat``; the module name is the file name
+  (:data:`NAME_RULE`: letters, digits, ``_``, 24 characters, not a keyword; the length is widely
+  cited, unverified). CRLF line endings, ASCII (WorkVisual and the pendant write CRLF).
+* The INI fold ``;FOLD INI;%{PE}`` with ``BASISTECH INI`` (``GLOBAL INTERRUPT DECL 3 WHEN
+  $STOPMESS==TRUE DO IR_STOPM ( )``, ``INTERRUPT ON 3``, ``BAS (#INITMOV,0 )``) and ``USER INI``:
+  the KSS 8 new-module template, as found verbatim in several public KR C4 programs (high
+  confidence).
+* Targets: ``E6POS`` ``{X,Y,Z,A,B,C,S,T}`` (mm, deg, S and T decimal as the pendant writes them
+  in .dat files) for Cartesian targets, ``E6AXIS`` ``{A1..A6}`` (deg) for joint targets; inline
+  aggregates or named points ``DECL E6POS XP1={..}`` in the .dat (the pendant's naming);
+  ``CIRC aux, end``. External axes E1..E6 are not written: on a robot without them they mean
+  nothing, and a written 0 would move an axis that exists.
+* ``$TOOL``/``$BASE``: ``{FRAME: ..}`` or ``TOOL_DATA[1..16]``/``BASE_DATA[1..32]`` (the arrays
+  of ``$config.dat``); ``$NULLFRAME`` for no tool / the world. ``$BASE`` is relative to
+  ``$WORLD``.
+* Speeds: ``$VEL.CP`` in m/s, ``$VEL.ORI1``/``$VEL.ORI2`` in deg/s, ``$VEL_AXIS[i]``/
+  ``$ACC_AXIS[i]`` in whole percent 1..100 (:data:`VEL_AXIS_MIN_PERCENT`, medium confidence);
+  approximation ``C_DIS`` with ``$APO.CDIS`` (mm), ``C_PTP`` with ``$APO.CPTP`` (INT, 1..100 %:
+  KUKA's mxAutomation manual describes the APO structure so, medium confidence).
+* ``$OUT[n] = TRUE``, ``WAIT SEC t``, ``WAIT FOR $IN[n]``, ``name(args)`` (the forms KUKA's inline
+  forms produce). I/O numbers 1..4096 (:data:`IO_RANGE`; KR C4's digital inputs and outputs as
+  recalled, unverified: a template folder may set the option ``io_range``).
+* Numbers: KRL's REAL is a 32-bit float (range ±3.4E+38, about 7 digits: medium confidence), so
+  every written value must be held by one to the resolution of :data:`NUMBERS`: positions to
+  0.01 mm, angles to 0.001°.
+* Comments: ``;`` to the end of the line; a comment of several lines becomes several ``;`` lines.
+* Call arguments: numbers, ``"strings"``, names, ``#ENUM`` values and ``$`` system variables.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any, ClassVar
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from olp.diagnostics import Diagnostic
+from olp.errors import PostError
+from olp.ir import CartesianTarget
+from olp.posts.base import Filter, Post
+from olp.posts.numbers import NumberFormat, Storage
+from olp.posts.text import IDENTIFIER, NUMBER, ArgumentRule, NameRule, double_quoted, one_of
+from olp.vendors.kuka import pose_to_frame, status_turn, turn_ambiguous
+
+if TYPE_CHECKING:
+    from olp.passes.resolve import CompiledProgram, Step
+    from olp.posts.view import PostStep
+
+_KEYWORDS = """
+AND ANIN ANOUT B_AND B_EXOR B_NOT B_OR BOOL BRAKE C_DIS C_ORI C_PTP C_VEL CASE CHAR CIRC
+CIRC_REL CONST CONTINUE DECL DEF DEFAULT DEFDAT DEFFCT DELAY DO ELSE END ENDDAT ENDFCT ENDFOR
+ENDIF ENDLOOP ENDSWITCH ENDWHILE ENUM EXIT EXOR EXT EXTFCT FALSE FOR GLOBAL GOTO HALT IF IMPORT
+INT INTERRUPT IS LIN LIN_REL LOOP MAXIMUM MINIMUM NOT OR PRIO PTP PTP_REL PUBLIC REAL REPEAT
+RESUME RETURN SEC SIGNAL STEP STRUC SWITCH THEN TO TRIGGER TRUE UNTIL WAIT WHEN WHILE
+"""
+KEYWORDS = frozenset(_KEYWORDS.split())
+"""KRL keywords (case-insensitive) a name must not be; from the KSS 8 expert programming manual's
+syntax chapters as remembered (medium confidence: the list may be incomplete)."""
+
+MAX_NAME_LENGTH = 24
+"""KRL identifiers and module names: 24 characters (widely cited; unverified against KUKA docs)."""
+
+NAME_RULE = NameRule(max_length=MAX_NAME_LENGTH, reserved=KEYWORDS)
+"""A legal KRL name: letters, digits and ``_``, a letter first, 24 characters, not a keyword (a
+keyword gets a trailing ``_``). The .src/.dat file names use it too: DEF name == file name."""
+
+VEL_AXIS_MIN_PERCENT = 1
+"""The smallest ``$VEL_AXIS`` / ``$ACC_AXIS`` value, %: INT, range 1 .. 100 (medium confidence;
+KUKA's own inline forms and public third-party KRL posts write whole percents). olp writes whole
+percents, rounded down (:func:`krl_percent`)."""
+
+TOOL_DATA_SIZE = 16
+"""``TOOL_DATA[1..16]`` in ``$config.dat`` (KSS 8; project vendor notes)."""
+BASE_DATA_SIZE = 32
+"""``BASE_DATA[1..32]`` in ``$config.dat`` (KSS 8; project vendor notes)."""
+
+NULL_FRAME = "$NULLFRAME"
+"""KRL's zero frame: ``$TOOL = $NULLFRAME`` is the bare flange, ``$BASE = $NULLFRAME`` the world
+(KSS 8 system variables)."""
+
+_REAL: Storage = "real32"
+
+NUMBERS: Mapping[str, NumberFormat] = {
+    **Post.NUMBERS,
+    "position": NumberFormat("position", "mm", 3, storage=_REAL, resolution=0.01),
+    "angle": NumberFormat("angle", "deg", 4, storage=_REAL, resolution=0.001),
+    "axis": NumberFormat("axis value", "deg", 5, storage=_REAL, resolution=0.001),
+    "vel_cp": NumberFormat(
+        "path speed $VEL.CP", "m/s", 5, low=0.0, low_open=True, storage=_REAL, resolution=1e-5
+    ),
+    "vel_ori": NumberFormat(
+        "orientation speed $VEL.ORI", "deg/s", 3, low=0.0, low_open=True, storage=_REAL
+    ),
+    "percent": NumberFormat("axis speed or acceleration", "%", 0, 1, 100, storage="int"),
+    "cdis": NumberFormat(
+        "approximation distance $APO.CDIS", "mm", 3, low=0.0, low_open=True, storage=_REAL
+    ),
+    "cptp": NumberFormat("approximation $APO.CPTP", "%", 0, 1, 100, storage="int"),
+    "wait": NumberFormat("dwell WAIT SEC", "s", 3, low=0.0, storage=_REAL, resolution=0.01),
+}
+"""How the KRL post writes each quantity (printed units)."""
+
+
+# --------------------------------------------------------------------------------------------
+# Spelling
+
+
+def krl_frame(post: Post, pose: ArrayLike) -> str:
+    """``X 1.000,Y 2.000,Z 3.000,A 0.0000,B 90.0000,C 0.0000`` from a pose (4, 4) in metres."""
+    x, y, z, a, b, c = pose_to_frame(pose)
+    values = [post.number("position", v) for v in (x, y, z)]
+    values += [post.number("angle", v) for v in (a, b, c)]
+    return ",".join(f"{k} {v}" for k, v in zip("XYZABC", values, strict=True))
+
+
+def krl_axis(post: Post, joints: ArrayLike) -> str:
+    """``A1 0.00000,A2 -90.00000,...`` from controller joint values (6,) in radians."""
+    deg = np.degrees(np.asarray(joints, dtype=np.float64))
+    return ",".join(f"A{i + 1} {post.number('axis', v)}" for i, v in enumerate(deg))
+
+
+def krl_e6pos(post: Post, pose: ArrayLike, status: int, turn: int) -> str:
+    """An E6POS value without braces, ``X ..,Y ..,Z ..,A ..,B ..,C ..,S 2,T 10``: a pose (4, 4)
+    in metres with Status and Turn (decimal, as the pendant writes them in .dat files)."""
+    return f"{krl_frame(post, pose)},S {int(status)},T {int(turn)}"
+
+
+def krl_point_type(post: Post, step: PostStep) -> str:
+    """``E6AXIS`` for a PTP to a joint target, and for a PTP whose Turn cannot select the
+    planned joints (``step.vendor["turn_ambiguous"]``, :func:`olp.vendors.kuka.turn_ambiguous`);
+    ``E6POS`` for every other motion."""
+    if step.kind == "joint" and (not step.cartesian or step.vendor.get("turn_ambiguous")):
+        return "E6AXIS"
+    return "E6POS"
+
+
+def krl_point(post: Post, step: PostStep) -> str:
+    """A step's target without braces: axis values where :func:`krl_point_type` says
+    ``E6AXIS``, else the TCP pose in the motion's base with the planned joints' Status and Turn
+    (LIN and CIRC ignore S and T, PTP honours them)."""
+    assert step.joints is not None
+    if krl_point_type(post, step) == "E6AXIS":
+        return krl_axis(post, step.joints)
+    assert step.pose is not None
+    return krl_e6pos(post, step.pose, step.vendor["status"], step.vendor["turn"])
+
+
+def krl_tool(post: Post, step: PostStep, mode: str = "inline") -> str:
+    """``$TOOL``: ``$NULLFRAME`` for the bare flange; ``{FRAME: ..}`` (the TCP in KUKA's flange
+    frame) in ``inline`` mode, ``TOOL_DATA[n]`` (the station's number, 1 .. 16) in ``indexed``."""
+    tool = step.tool
+    assert tool is not None and tool.pose is not None
+    if _is_identity(tool.pose):
+        return NULL_FRAME
+    if mode == "indexed":
+        return f"TOOL_DATA[{_index(step, tool, TOOL_DATA_SIZE, 'tool')}]"
+    return "{FRAME: " + krl_frame(post, tool.pose) + "}"
+
+
+def krl_base(post: Post, step: PostStep, mode: str = "inline") -> str:
+    """``$BASE``: ``$NULLFRAME`` when the frame is the reference itself; ``{FRAME: ..}``
+    (``step.frame_pose``) in ``inline`` mode, ``BASE_DATA[n]`` (1 .. 32) in ``indexed``."""
+    assert step.frame_pose is not None
+    if _is_identity(step.frame_pose):
+        return NULL_FRAME
+    if mode == "indexed":
+        return f"BASE_DATA[{_index(step, step.frame, BASE_DATA_SIZE, 'base')}]"
+    return "{FRAME: " + krl_frame(post, step.frame_pose) + "}"
+
+
+def krl_percent(post: Post, fraction: float) -> str:
+    """A fraction (0, 1] as a whole ``$VEL_AXIS``/``$ACC_AXIS`` percent, rounded down (never
+    faster than planned; a fraction within 1e-9 of a whole percent counts as it), at least 1."""
+    return post.number("percent", max(VEL_AXIS_MIN_PERCENT, whole_percent(fraction)))
+
+
+def whole_percent(fraction: float) -> int:
+    """``floor(100 · fraction)``, with fractions within 1e-9 % of a whole percent on it."""
+    return math.floor(float(fraction) * 100.0 + 1e-9)
+
+
+def _is_identity(pose: ArrayLike) -> bool:
+    return bool(np.allclose(pose, np.eye(4), rtol=0.0, atol=1e-12))
+
+
+def _index(step: PostStep, item: Any, size: int, what: str) -> int:
+    number = item.number
+    if number is None or not 1 <= number <= size:
+        raise PostError(
+            f"{what} {item.name!r} needs a number 1..{size} for {what.upper()}_DATA "
+            f"(it has {number})",
+            step.instruction.span,
+            hint="give it a number in the station, or use the post option frames: inline",
+        )
+    return int(number)
+
+
+FILTERS: Mapping[str, Filter] = {
+    **Post.FILTERS,
+    "krl_frame": krl_frame,
+    "krl_axis": krl_axis,
+    "krl_e6pos": krl_e6pos,
+    "krl_point": krl_point,
+    "krl_point_type": krl_point_type,
+    "krl_tool": krl_tool,
+    "krl_base": krl_base,
+    "krl_percent": krl_percent,
+}
+
+
+class KukaPost(Post):
+    """KUKA KR C4 (KSS 8) KRL; see the module docstring."""
+
+    NAME = "kuka"
+    VENDOR = "kuka"
+    LANGUAGE = "KRL"
+    NAME_RULE = NAME_RULE
+    IO_RANGE = (1, 4096)
+    CALL_ARGUMENTS = ArgumentRule(
+        one_of(NUMBER, double_quoted(), IDENTIFIER, "#" + IDENTIFIER, r"\$" + IDENTIFIER),
+        'numbers, "strings", names, #ENUM values, $ variables',
+    )
+    NUMBERS: ClassVar[Mapping[str, NumberFormat]] = NUMBERS
+    FILTERS: ClassVar[Mapping[str, Filter]] = FILTERS
+
+    def step_values(self, robot: Any, joints: Any) -> list[Mapping[str, Any]]:
+        """Status and Turn of each motion's planned joints (N, 6) rad, and whether Turn cannot
+        select them within ``robot``'s joint limits (:func:`olp.vendors.kuka.turn_ambiguous`)."""
+        q = np.asarray(joints, dtype=np.float64)
+        try:
+            status, turn = status_turn(robot, q)
+        except (TypeError, ValueError) as exc:
+            raise PostError(f"the KRL post cannot describe robot {robot.name!r}: {exc}") from exc
+        limits = robot.limits
+        ambiguous = turn_ambiguous(q, limits.lower, limits.upper)
+        rows = zip(status.tolist(), turn.tolist(), ambiguous.tolist(), strict=True)
+        return [{"status": int(s), "turn": int(t), "turn_ambiguous": bool(a)} for s, t, a in rows]
+
+    def check_instruction(self, step: Step, compiled: CompiledProgram) -> list[Diagnostic]:
+        """* ``zone_dropped`` (warning): without the option ``ptp_approximation`` (a
+          ``$APO.CPTP`` percentage), joint moves with a zone are written as exact stops: KRL
+          approximates PTP with ``C_PTP`` and ``$APO.CPTP`` in percent of an axis-specific
+          distance, which a TCP distance zone does not translate to (timing assumes stops).
+        * ``joint_speed`` (error): a joint speed or acceleration below 1 %; (warning) one that
+          is not a whole percent, written rounded down (:func:`krl_percent`).
+        * ``ptp_axis_values`` (warning): a PTP to a Cartesian target written as axis values,
+          because Turn cannot tell two turns of an axis apart on this robot."""
+        ins: Any = step.instruction
+        if ins.kind != "joint" or step.skipped:
+            return []
+        return _joint_checks(step.index, ins, self.options) + _ambiguity(
+            compiled.station.robot, step
+        )
+
+
+def _ambiguity(robot: Any, step: Step) -> list[Diagnostic]:
+    ins: Any = step.instruction
+    if step.joints is None or not isinstance(ins.target, CartesianTarget):
+        return []
+    if not turn_ambiguous(step.joints, robot.limits.lower, robot.limits.upper):
+        return []
+    message = (
+        "PTP written with axis values: Status/Turn cannot select the planned joints on this "
+        "robot (an axis has two turns of the same sign within its limits)"
+    )
+    return [Diagnostic("warning", "ptp_axis_values", message, ins.span, step.index)]
+
+
+def _joint_checks(index: int, ins: Any, options: Mapping[str, Any]) -> list[Diagnostic]:
+    out = []
+    if not ins.zone.is_fine and not options.get("ptp_approximation"):
+        out.append(
+            Diagnostic(
+                "warning",
+                "zone_dropped",
+                f"PTP with a {ins.zone.radius * 1000:.1f} mm zone is written as an exact stop",
+                ins.span,
+                index,
+            )
+        )
+    for what, fraction in (
+        ("speed", ins.speed.joint),
+        ("acceleration", ins.speed.joint_acceleration),
+    ):
+        percent = fraction * 100.0
+        if whole_percent(fraction) < VEL_AXIS_MIN_PERCENT:
+            message = (
+                f"joint {what} {percent:.6g} % is below KRL's smallest $VEL_AXIS/$ACC_AXIS "
+                f"value, {VEL_AXIS_MIN_PERCENT} %"
+            )
+            out.append(Diagnostic("error", "joint_speed", message, ins.span, index))
+        elif abs(percent - whole_percent(fraction)) > 1e-6:
+            written = whole_percent(fraction)
+            message = f"joint {what} {percent:.2f} % written as {written} % (KRL: whole percents)"
+            out.append(Diagnostic("warning", "joint_speed", message, ins.span, index))
+    return out

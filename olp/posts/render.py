@@ -1,0 +1,283 @@
+"""Rendering a compiled program through a post: the template context, splitting into parts,
+and located errors for what cannot be written.
+
+:func:`render` builds the view once (:class:`olp.posts.view.ProgramView`), splits the steps by the
+manifest's ``limits`` (finer until ``max_lines_per_file`` holds), and renders each file's
+templates in the post's sandbox (:mod:`olp.posts.sandbox`). While a template walks ``steps``, the
+step it is on is remembered, so that a number the post refuses (:mod:`olp.posts.numbers`) becomes
+an error diagnostic on that instruction's source line; rendering goes on to find every such
+number, and :class:`RenderError` carries them all. Nothing is returned while one remains.
+
+Template context (every file)
+-----------------------------
+``program``
+    ``name`` (legal name of this file's program: the whole program, a part, or the main),
+    ``source`` (the program's file name without folders, escaped for a comment), ``main`` (the
+    main program's name).
+``split``
+    True when the program was split (in parts and in the main).
+``unit``
+    ``name``, ``routine`` (the name of the routine to define: for the whole program or the main
+    the option ``entry``, default the program's name; for a part the option ``part_routine``,
+    a pattern like ``"{name}_run"``, default the part's name), ``index`` (0 for the whole
+    program or the main, k for part k), ``count`` (number of parts, 0 when not split),
+    ``is_part``, ``is_main`` (the whole program or the main).
+``parts``
+    In ``main_files``: the parts in call order, each ``{name, index, routine}``; else empty.
+``steps``
+    This file's instructions (:class:`olp.posts.view.PostStep`); empty in ``main_files``.
+``tools`` / ``frames``
+    The tools and frames this file's motions use (the main: all of the program's), each a
+    :class:`~olp.posts.view.PostTool` / :class:`~olp.posts.view.PostFrame` with a legal unique
+    name.
+``vendor``
+    What the post's ``context_values`` returns for this file (ABB's custom speed and zone data).
+``modal``
+    A :class:`~olp.posts.view.Modal` change tracker: ``modal.changed("cdis", v)``; fresh for
+    every file.
+``station``, ``robot`` (``station.robot``), ``options``, ``post`` (``name``, ``vendor``).
+
+Output never depends on the locale (Python's ``format`` is locale-independent), nor on hash seeds
+(no set iteration reaches the text).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator, Mapping, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from olp.diagnostics import Diagnostic
+from olp.errors import PostError
+from olp.posts.text import basename
+from olp.posts.view import Allocation, Modal, Names, PostFrame, PostStep, PostTool, ProgramView
+from olp.transforms.split import SplitLimits, part_names, split_steps
+
+if TYPE_CHECKING:
+    from olp.passes.resolve import CompiledProgram, Step
+    from olp.posts.base import Post
+
+
+class RenderError(Exception):
+    """What a post could not write: error diagnostics, each on its instruction."""
+
+    def __init__(self, diagnostics: Sequence[Diagnostic]) -> None:
+        super().__init__("; ".join(d.message for d in diagnostics))
+        self.diagnostics = tuple(diagnostics)
+
+
+class TrackedSteps(list[PostStep]):
+    """A file's steps; iterating them tells the post which instruction is being written."""
+
+    def __init__(self, steps: Sequence[PostStep], post: Post) -> None:
+        super().__init__(steps)
+        self.post = post
+
+    def __iter__(self) -> Iterator[PostStep]:
+        for step in super().__iter__():
+            self.post.current_step = step
+            yield step
+        self.post.current_step = None
+
+
+_MAX_SPLIT_ROUNDS = 12
+"""How often :func:`render` splits finer to meet ``max_lines_per_file`` before it gives up."""
+
+
+def render(compiled: CompiledProgram, post: Post, name: str | None = None) -> dict[str, str]:
+    """Render every file of ``post``: ``{file name: text}``. Raises :class:`RenderError` (with
+    located diagnostics) for numbers that cannot be written, PostError for a broken post; writes
+    nothing.
+
+    Splits the program into parts when the manifest's ``limits`` ask for it (splitting finer
+    until every file has at most ``max_lines_per_file`` lines).
+    """
+    manifest = post.manifest
+    renderer = _Renderer(compiled, post, name)
+    limits = manifest.limits
+    for _ in range(_MAX_SPLIT_ROUNDS):
+        parts = split_steps(compiled.steps, limits)
+        post.problems, post.collecting = [], True
+        try:
+            files = renderer.render(parts)
+        finally:
+            post.collecting = False
+        if post.problems:
+            raise RenderError(_unique(post.problems))
+        longest, lines = _longest(files, manifest.line_ending)
+        if manifest.limits.max_lines is None or lines <= manifest.limits.max_lines:
+            return files
+        limits = _finer(limits, parts, lines, manifest.limits.max_lines, longest, renderer)
+    raise PostError(f"post {manifest.name!r}: could not meet max_lines_per_file by splitting")
+
+
+def _unique(found: Sequence[Diagnostic]) -> list[Diagnostic]:
+    """One diagnostic per message and instruction (a number written in two files counts once)."""
+    seen: set[tuple[str, int | None]] = set()
+    out = []
+    for diag in found:
+        key = (diag.message, diag.index)
+        if key not in seen:
+            seen.add(key)
+            out.append(diag)
+    return out
+
+
+def _longest(files: Mapping[str, str], ending: str) -> tuple[str, int]:
+    counts = {f: text.count(ending) + (not text.endswith(ending)) for f, text in files.items()}
+    fname = max(counts, key=lambda f: (counts[f], f))
+    return fname, counts[fname]
+
+
+def _finer(
+    limits: SplitLimits,
+    parts: list[tuple[Step, ...]],
+    lines: int,
+    max_lines: int,
+    longest: str,
+    renderer: _Renderer,
+) -> SplitLimits:
+    """Tighter instruction limits after a file came out with ``lines`` > ``max_lines``."""
+    biggest = max(sum(1 for s in p if not s.skipped) for p in parts)
+    if longest in renderer.main_file_names or biggest <= 1:
+        raise PostError(
+            f"post {renderer.manifest.name!r}: {longest} has {lines} lines, more than "
+            f"max_lines_per_file {max_lines}, and splitting cannot make it shorter"
+        )
+    fewer = max(1, min(biggest - 1, math.floor(biggest * max_lines / lines)))
+    return SplitLimits(limits.max_motions, fewer, limits.max_lines)
+
+
+class _Renderer:
+    """Renders one compiled program through one post, for a given split."""
+
+    def __init__(self, compiled: CompiledProgram, post: Post, name: str | None):
+        self.compiled = compiled
+        self.post = post
+        self.manifest = post.manifest
+        self.rule = post.NAME_RULE
+        self.name = self.rule.legal(name or compiled.program.name)
+        self.view = ProgramView(compiled, post)
+        self.env = post.environment()
+        self.source = post.plain_text(basename(compiled.program.source))
+        self.main_file_names: set[str] = set()
+
+    def render(self, parts: list[tuple[Step, ...]]) -> dict[str, str]:
+        split = len(parts) > 1
+        rule = self.rule
+        unit_names = part_names(self.name, len(parts), rule.legal, rule.max_length) if split else []
+        names = Names(rule, [self.name, *unit_names, *self.post.PREDEFINED_NAMES])
+        options = self.manifest.options
+        entry = names.take(str(options["entry"])) if "entry" in options else self.name
+        routines = [
+            names.take(str(options.get("part_routine", "{name}")).format(name=n))
+            if "part_routine" in options
+            else n
+            for n in unit_names
+        ]
+        allocation = self.view.allocate(names)
+        if not split:
+            return self._files(self.manifest.files, self._unit(parts[0], allocation, 0, 0, entry))
+        main = self._unit((), allocation, 0, len(parts), entry)
+        main["parts"] = [
+            {"name": n, "index": k + 1, "routine": r}
+            for k, (n, r) in enumerate(zip(unit_names, routines, strict=True))
+        ]
+        main["tools"], main["frames"] = _used(allocation, [s.index for s in self.compiled.steps])
+        main_files = self._files(self.manifest.main_files, main)
+        self.main_file_names = set(main_files)
+        files: dict[str, str] = {}
+        for k, (steps, unit_name) in enumerate(zip(parts, unit_names, strict=True)):
+            unit = self._unit(steps, allocation, k + 1, len(parts), routines[k], unit_name)
+            files.update(self._files(self.manifest.files, unit, clash=files.keys() | main_files))
+        return {**main_files, **files}
+
+    def _unit(
+        self,
+        steps: Sequence[Step],
+        allocation: Allocation,
+        index: int,
+        count: int,
+        routine: str,
+        unit_name: str | None = None,
+    ) -> dict[str, Any]:
+        view = self.view.unit_steps(steps, allocation)
+        tools, frames = _used(allocation, [s.index for s in view])
+        name = unit_name or self.name
+        return {
+            "program": {"name": name, "source": self.source, "main": self.name},
+            "split": count > 0,
+            "unit": {
+                "name": name,
+                "routine": routine,
+                "index": index,
+                "count": count,
+                "is_part": index > 0,
+                "is_main": index == 0,
+            },
+            "parts": [],
+            "steps": TrackedSteps(view, self.post),
+            "tools": tools,
+            "frames": frames,
+            "vendor": self.post.context_values(view),
+            "station": self.compiled.station,
+            "robot": self.compiled.station.robot,
+            "options": self.manifest.options,
+            "post": {"name": self.manifest.name, "vendor": self.manifest.vendor},
+        }
+
+    def _files(
+        self,
+        entries: Sequence[tuple[str, str]],
+        context: dict[str, Any],
+        clash: Any = frozenset(),
+    ) -> dict[str, str]:
+        import jinja2
+
+        files: dict[str, str] = {}
+        for template, pattern in entries:
+            context["modal"] = Modal()
+            self.post.current_step = None
+            try:
+                text = self.env.get_template(template).render(**context)
+            except jinja2.TemplateError as exc:
+                path = self.manifest.folder / template
+                where = self.post.current_step
+                at = f" (writing {where.source})" if where is not None else ""
+                raise PostError(
+                    f"{path}:{_template_line(exc, path)}: template error{at}: {exc}"
+                ) from exc
+            fname = pattern.format(name=context["program"]["name"])
+            if fname in files or fname in clash:
+                raise PostError(f"post {self.manifest.name!r} writes {fname} twice")
+            files[fname] = _line_endings(text, self.manifest.line_ending)
+        return files
+
+
+def _template_line(exc: Exception, path: Path) -> int | str:
+    """The template line an error came from: syntax errors carry it; for runtime errors Jinja
+    rewrites the traceback so that a frame points into the template file."""
+    line = getattr(exc, "lineno", None)
+    tb = exc.__traceback__
+    while tb is not None:
+        if Path(tb.tb_frame.f_code.co_filename) == path:
+            line = tb.tb_lineno
+        tb = tb.tb_next
+    return line if line is not None else "?"
+
+
+def _used(allocation: Allocation, indices: Sequence[int]) -> tuple[list[PostTool], list[PostFrame]]:
+    """The distinct tools and frames of the motions at ``indices``, in order of first use."""
+    tools: dict[str, PostTool] = {}
+    frames: dict[str, PostFrame] = {}
+    for i in indices:
+        if i in allocation.tools:
+            tools.setdefault(allocation.tools[i].name, allocation.tools[i])
+            frames.setdefault(allocation.frames[i].name, allocation.frames[i])
+    return list(tools.values()), list(frames.values())
+
+
+def _line_endings(text: str, ending: str) -> str:
+    lines = text.replace("\r\n", "\n").split("\n")
+    return ending.join(line.rstrip() for line in lines)

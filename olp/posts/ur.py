@@ -1,0 +1,221 @@
+"""The URScript post (Universal Robots CB3 / e-Series): one ``name.script``.
+
+Conventions shared with frontends (rotation vectors, the flange, no configuration bits) live in
+:mod:`olp.vendors.ur`; this module is how the post spells them. Pinned by
+``tests/posts/test_ur.py``, the cross-post table and the golden files ``tests/golden/ur/``.
+
+* A program is one ``def name():`` ... ``end`` block, body indented by two spaces, ``#``
+  comments, LF line endings, file ``name.script`` (project vendor notes: sent as plain text to
+  port 30002, which runs the ``def``; medium confidence that nothing else is needed).
+* ``movej([q1..q6], a, v, r)``: the planned joints (rad), never a pose (see Configuration).
+  ``v`` (rad/s) is the speed of the leading axis (URScript manual, ``movej``); olp writes
+  ``Speed.joint`` (a fraction of each axis' maximum) times the *smallest* axis velocity limit of
+  the station's robot (:func:`movej_speed`): at 100 % the leading axis may then run at the
+  slowest axis' maximum, so no axis exceeds its own. ``a`` (rad/s²) is URScript's documented
+  default 1.4 rad/s² times ``Speed.joint_acceleration`` (:func:`movej_acceleration`): UR
+  publishes no joint acceleration limits, and olp's timing uses the station's limits, which
+  may therefore differ from the controller's motion.
+* ``movel(p[...], a, v, r)`` / ``movec(p_via, p_to, a, v, r, mode=0)``: the TCP pose in the
+  robot's Base frame: the post's manifest says ``frames_in: robot_base``, so the template's
+  ``base_pose`` is the target in ``station base · controller_base`` (for UR arms the kinematic
+  base *is* the controller's Base, DH frame 0, see :mod:`olp.kinematics.ur`; the target equals
+  forward kinematics of the planned joints, which resolve solved for it), and olp's user frames
+  need no counterpart on the controller. ``v`` = ``Speed.linear`` (m/s), ``a`` = URScript's default
+  1.2 m/s² (the IR has no linear acceleration). ``mode=0``: orientation interpolated from the
+  start to the end pose, like KRL's default CIRC (URScript manual, ``movec``; medium
+  confidence).
+* ``r`` (m): the zone radius capped by :mod:`olp.transforms.blend` (neighbouring blends must not
+  overlap, ``r = 0`` where the robot stops; project vendor notes).
+* ``set_tcp(p[...])``: the tool's TCP in the flange frame, before the first motion with it.
+* ``set_digital_out(n, b)``, ``get_digital_in(n)`` polled with ``sync()`` for an input wait,
+  ``sleep(s)``; output and input numbers 0..9 (e-Series script manual: ``set_digital_out``
+  "Deprecated ... integer: [0:9]", ports 8-9 are the tool's; ``set_standard_digital_out`` takes
+  0..7; high confidence). The IR's I/O number is written unchanged.
+* Calls: ``name(args)``; the function must exist on the controller (e.g. in the installation's
+  script). Arguments must be numbers or double-quoted strings.
+* Very long scripts fail on the controller (field reports between ~1,000 and 2,500 targets):
+  above :data:`MAX_MOTIONS` motions a warning asks for splitting or streaming.
+* Numbers: URScript's float width is unverified (believed 64-bit); positions are written to
+  1 µm and checked to 10 µm, speeds and accelerations must stay positive once printed, and a
+  ``sleep`` above :data:`MAX_SLEEP` s is refused (olp's bound; URScript states none).
+* Comments: ``#`` to the end of the line, whitespace collapsed; a comment of several lines
+  becomes several ``#`` lines.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any, ClassVar
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from olp.diagnostics import Diagnostic
+from olp.posts.base import Filter, Post
+from olp.posts.numbers import NumberFormat
+from olp.posts.text import ArgumentRule, CommentRule, NameRule
+from olp.vendors.ur import pose_to_ur
+
+if TYPE_CHECKING:
+    from olp.passes.resolve import CompiledProgram
+    from olp.posts.view import PostStep
+
+_KEYWORDS = """
+def end if elif else while for return thread run kill halt break continue pass global local
+and or not xor True False
+"""
+KEYWORDS = frozenset(_KEYWORDS.split())
+"""URScript words a program name must not be (Python-like; unverified list)."""
+
+POST_BUILTINS = frozenset(
+    ["movej", "movel", "movec", "set_tcp", "set_digital_out", "get_digital_in", "sleep", "sync"]
+)
+"""URScript functions the post calls: a program of the same name would shadow them."""
+
+NAME_RULE = NameRule(reserved=KEYWORDS | POST_BUILTINS, case_sensitive=True, prefix="p")
+"""A legal ``def`` name: ASCII letters, digits and ``_``, a letter first (``p`` is put in front
+otherwise); a keyword, or a function the post calls, gets a trailing ``_``."""
+
+MOVEJ_ACCELERATION = 1.4
+"""rad/s², URScript's ``movej`` default: ``a`` at 100 % joint acceleration."""
+MOVEL_ACCELERATION = 1.2
+"""m/s², URScript's ``movel``/``movec`` default."""
+MAX_MOTIONS = 1000
+"""Motions in one script above which a warning asks for splitting or streaming (field reports of
+trouble between ~1,000 and 2,500 targets; low confidence on the exact limit)."""
+MAX_SLEEP = 1e6
+"""s: the longest ``sleep`` olp writes (olp's bound, about 11.6 days)."""
+
+NUMBERS: Mapping[str, NumberFormat] = {
+    **Post.NUMBERS,
+    "position": NumberFormat("position", "m", 6, resolution=1e-5),
+    "angle": NumberFormat("angle", "rad", 6, resolution=1e-5),
+    "speed": NumberFormat("speed", "m/s or rad/s", 5, low=0.0, low_open=True),
+    "acceleration": NumberFormat("acceleration", "m/s² or rad/s²", 5, low=0.0, low_open=True),
+    "radius": NumberFormat("blend radius", "m", 6, low=0.0),
+    "sleep": NumberFormat("sleep", "s", 3, 0.0, MAX_SLEEP),
+}
+"""How the URScript post writes each quantity."""
+
+_LITERAL = re.compile(r'[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?|"[^"\\\x00-\x1f\x7f-\x9f]*"')
+
+
+# --------------------------------------------------------------------------------------------
+# Spelling
+
+
+def ur_pose(post: Post, pose: ArrayLike) -> str:
+    """``p[x, y, z, rx, ry, rz]`` from a pose (4, 4) in metres."""
+    v = pose_to_ur(pose)
+    values = [post.number("position", x) for x in v[:3]]
+    values += [post.number("angle", x) for x in v[3:]]
+    return "p[" + ", ".join(values) + "]"
+
+
+def ur_joints(post: Post, joints: ArrayLike) -> str:
+    """``[q1, ..., q6]`` in rad (the ``movej`` joint target) from controller joints (6,) in rad."""
+    return "[" + ", ".join(post.number("angle", x) for x in np.asarray(joints, float)) + "]"
+
+
+def movej_speed(post: Post, speed: Any, robot: Any) -> str:
+    """``v`` of ``movej`` in rad/s: ``speed.joint`` times the smallest axis velocity limit."""
+    return post.number("speed", speed.joint * float(np.min(robot.limits.velocity)))
+
+
+def movej_acceleration(post: Post, speed: Any) -> str:
+    """``a`` of ``movej`` in rad/s²: 1.4 rad/s² times ``speed.joint_acceleration``."""
+    return post.number("acceleration", speed.joint_acceleration * MOVEJ_ACCELERATION)
+
+
+def movel_acceleration(post: Post, _speed: Any = None) -> str:
+    """``a`` of ``movel``/``movec`` in m/s²: URScript's default."""
+    return post.number("acceleration", MOVEL_ACCELERATION)
+
+
+def linear_speed(post: Post, speed: Any) -> str:
+    """``v`` of ``movel``/``movec`` in m/s: ``speed.linear``."""
+    return post.number("speed", speed.linear)
+
+
+def radius(post: Post, value: float) -> str:
+    """A blend radius in metres (6 decimals)."""
+    return post.number("radius", value)
+
+
+def seconds(post: Post, value: float) -> str:
+    """A ``sleep`` time in seconds (3 decimals)."""
+    return post.number("sleep", value)
+
+
+def _via_filter(post: Post, step: PostStep) -> str:
+    """Template filter: ``s | ur_via``, the ``p[...]`` of a circle's via point in the robot's
+    Base frame (the post's ``frames_in: robot_base`` makes ``frame_pose`` relative to it)."""
+    return ur_pose(post, np.asarray(step.frame_pose) @ np.asarray(step.via))
+
+
+def _blends_filter(post: Post, steps: Any, station: Any) -> dict[int, float]:
+    """Template filter: ``steps | ur_blend_radii(station)``, instruction index -> capped blend
+    radius in m (:func:`olp.transforms.blend.blend_radii`, from the robot's home joints). The
+    bundled template writes the zone radius, which :class:`UrPost`'s transform already capped;
+    folders made before keep working."""
+    from olp.transforms.blend import blend_radii
+
+    robot = station.robot
+    return {c.index: c.radius for c in blend_radii(list(steps), robot, robot.home)}
+
+
+FILTERS: Mapping[str, Filter] = {
+    **Post.FILTERS,
+    "ur_pose": ur_pose,
+    "ur_joints": ur_joints,
+    "ur_via": _via_filter,
+    "ur_blend_radii": _blends_filter,
+    "ur_movej_v": movej_speed,
+    "ur_movej_a": movej_acceleration,
+    "ur_movel_v": linear_speed,
+    "ur_movel_a": movel_acceleration,
+    "ur_radius": radius,
+    "ur_seconds": seconds,
+}
+
+
+def cap_blend_radii(
+    compiled: CompiledProgram, post: Post
+) -> tuple[CompiledProgram, list[Diagnostic]]:
+    """The transform :func:`olp.transforms.blend.cap_blends`: neighbouring blends never overlap
+    and the robot stops where it must (the controller skips moves whose blends overlap)."""
+    from olp.transforms.blend import cap_blends
+
+    capped, found = cap_blends(compiled)
+    return capped, list(found)
+
+
+class UrPost(Post):
+    """Universal Robots URScript; see the module docstring."""
+
+    NAME = "ur"
+    VENDOR = "ur"
+    LANGUAGE = "URScript"
+    NAME_RULE = NAME_RULE
+    COMMENTS = CommentRule(collapse=True)
+    IO_RANGE = (0, 9)
+    CALL_ARGUMENTS = ArgumentRule(_LITERAL, 'numbers and "strings" without " or \\')
+    NUMBERS: ClassVar[Mapping[str, NumberFormat]] = NUMBERS
+    FILTERS: ClassVar[Mapping[str, Filter]] = FILTERS
+    TRANSFORMS = (cap_blend_radii,)
+
+    def check_program(self, compiled: CompiledProgram) -> list[Diagnostic]:
+        """``program_too_long`` (warning): more than :data:`MAX_MOTIONS` motions."""
+        motions = sum(1 for s in compiled.steps if s.joints is not None)
+        if motions <= MAX_MOTIONS:
+            return []
+        return [
+            Diagnostic(
+                "warning",
+                "program_too_long",
+                f"{motions} motions in one script: UR controllers are reported to fail on "
+                f"scripts beyond about {MAX_MOTIONS} targets",
+                hint="split the program or stream it to the controller",
+            )
+        ]
