@@ -6,10 +6,15 @@ What is checked (coal through pinocchio's ``GeometryModel``; meshes as convex hu
   fixtures (kind ``collision``);
 * the robot's links, tool and carried parts against each other (kind ``self_collision``), except
   bodies on the same or on adjacent joints (the tool and a carried part sit on the last joint, so
-  they may touch the last two links), pairs already closer than the clearance at the home
-  position (the overlapping capsules of a simplified model) and declared ``allowed_pairs``;
+  they may touch the last two links), the link pairs the robot library declares (capsules that
+  overlap by construction), link and tool shapes proven to overlap in every configuration (a
+  tool's bracket inside the wrist's capsule) — see :mod:`olp.collision.scene`;
+* never the pairs the station's ``allowed_pairs`` or :attr:`CollisionOptions.allowed_pairs` name;
 * by default the tool may touch and enter *parts* (machining, welding, screwing); it is checked
   against fixtures.
+
+The set of checked pairs does not depend on the clearance: a larger ``clearance_m`` only adds
+margin, so a program that fails at one clearance fails at every larger one.
 
 Along every motion the piecewise-linear joint path between the resolve pass's samples is proven
 free by conservative advancement (:mod:`olp.collision.advance`): if nothing is reported, every
@@ -65,16 +70,19 @@ class Attachment:
 class CollisionOptions:
     """Settings of the collision check.
 
-    ``clearance_m``: bodies closer than this (m) collide (0: only overlap counts).
-    ``tolerance_m``: the resolution: a pair closer than ``clearance_m - tolerance_m`` anywhere
-    on a motion is always reported; one that stays above ``clearance_m - tolerance_m / 2`` never
-    is (so parts resting on fixtures do not collide). ``allowed_pairs``: pairs of body names
-    never checked (robot links by link name, e.g. ``"link_3"``; the tool by its station name;
-    parts and fixtures by name). ``self_collision``: check the robot's bodies against each other.
-    ``tool_touches_parts``: the tool may touch and enter parts. ``home_contacts``: allow the
-    robot-side pairs already in contact at the home position. ``attachments``: parts carried by
-    the tool (pick and place). ``mode``: ``"advance"`` proves the path between samples free;
-    ``"samples"`` checks the resolve samples only (a reference that misses thin obstacles).
+    ``clearance_m``: bodies closer than this (m) collide (0: only overlap counts); it adds margin
+    to every checked pair and never changes which pairs are checked. ``tolerance_m``: the
+    resolution: a pair closer than ``clearance_m - tolerance_m`` anywhere on a motion is always
+    reported; one that stays above ``clearance_m - tolerance_m / 2`` never is (so parts resting
+    on fixtures do not collide). ``allowed_pairs``: pairs of body names never checked, added to
+    the station's (robot links by link name, e.g. ``"link_3"``; the tool by its station name;
+    parts and fixtures by name). ``self_collision``: check the robot's bodies against each
+    other. ``tool_touches_parts``: the tool may touch and enter parts. ``home_contacts``: also
+    allow the link and tool pairs that overlap at the home position (off by default: one pose
+    does not show that two bodies always touch; the robot library declares the pairs that do).
+    ``attachments``: parts carried by the tool (pick and place). ``mode``: ``"advance"`` proves
+    the path between samples free; ``"samples"`` checks the resolve samples only (a reference
+    that misses thin obstacles).
     """
 
     clearance_m: float = 0.0
@@ -82,7 +90,7 @@ class CollisionOptions:
     allowed_pairs: tuple[tuple[str, str], ...] = ()
     self_collision: bool = True
     tool_touches_parts: bool = True
-    home_contacts: bool = True
+    home_contacts: bool = False
     attachments: tuple[Attachment, ...] = ()
     mode: Literal["advance", "samples"] = "advance"
 
@@ -292,11 +300,10 @@ def _scene(station: Station, step: Step, world: _World, opts: CollisionOptions) 
         Placed(n, shapes[n].kind, p, shapes[n].shapes) for n, p in sorted(world.objects.items())
     ]
     rules = PairRules(
-        allowed=frozenset(frozenset(p) for p in opts.allowed_pairs),
+        allowed=frozenset(frozenset(p) for p in (*station.allowed_pairs, *opts.allowed_pairs)),
         tool_touches_parts=opts.tool_touches_parts,
         self_collision=opts.self_collision,
         home_contacts=opts.home_contacts,
-        contact_below=opts.clearance_m - opts.tolerance_m / 2,
     )
     return build_scene(station.robot, tool, carried, objects, rules)
 
@@ -366,7 +373,8 @@ def _diagnostics(found: Sequence[_Found], clearance: float) -> list[Diagnostic]:
 _HINTS = {
     "collision": "add a via point or change the approach so the path goes around the obstacle, "
     "or move the obstacle",
-    "self_collision": "use another robot configuration (IK branch) or add a via point",
+    "self_collision": "use another robot configuration (IK branch) or add a via point; if the "
+    "two shapes touch by construction, declare the pair in allowed_pairs (station or robot file)",
 }
 
 
