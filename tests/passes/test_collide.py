@@ -796,3 +796,124 @@ def test_home_contacts_is_the_callers_choice_and_ignores_the_clearance(cell: Sta
         hits = _hits(check_collisions(compiled, chosen))
         assert {pair for _, pair, _ in hits} == {("robot link_2", "robot base")}
         assert ("self_collision", ("robot link_2", "robot base"), 1) in hits
+
+
+# --------------------------------------------------------------------------------------------
+# Absurd but valid input: a diagnostic or a usage error, never a traceback or a silent pass
+
+
+@pytest.mark.parametrize(
+    "options",
+    [
+        {"clearance_m": -0.001},
+        {"clearance_m": float("nan")},
+        {"clearance_m": float("inf")},
+        {"tolerance_m": 0.0},
+        {"tolerance_m": -1e-4},
+        {"tolerance_m": float("nan")},
+        {"tolerance_m": float("inf")},
+        {"tolerance_m": 1e-9},
+        {"tolerance_m": 0.1},
+        {"mode": "fast"},
+    ],
+)
+def test_bad_collision_options_are_usage_errors(options: dict[str, object]) -> None:
+    from olp.errors import UsageError
+
+    with pytest.raises(UsageError, match=r"collision (clearance|tolerance|mode)"):
+        CollisionOptions(**options)  # type: ignore[arg-type]
+
+
+def test_an_infinite_clearance_on_the_command_line_is_a_usage_error(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from olp.cli import main
+
+    program = tmp_path / "bump.src"
+    program.write_text(BUMP_SRC)
+    station = str(REPO / "stations" / "kr6_milling_cell.yaml")
+    assert main(["check", station, str(program), "--clearance", "1e400"]) == 2
+    assert "clearance must be a finite distance" in capsys.readouterr().err
+
+
+def test_a_huge_clearance_reports_every_checked_pair_once(cell: Station) -> None:
+    from olp.passes.collide import check_collisions_with_stats
+
+    found, stats = check_collisions_with_stats(_bump(cell), CollisionOptions(clearance_m=1e6))
+    assert len(found) == stats.pairs > 10
+    assert all("(closer than 1000000000.0 mm)" in d.message for d in found)
+
+
+def test_zero_length_motions_are_checked_like_any_other(cell: Station) -> None:
+    home = cell.robot.home
+    assert check_collisions(_compile(cell, _ptp(home, 2), _ptp(home, 3), _ptp(home, 4))) == []
+    folded = np.radians([0, -10, 156, 0, 0, 0])  # the wrist on the base
+    found = check_collisions(_compile(cell, _ptp(folded, 2), _ptp(folded, 3), _ptp(folded, 4)))
+    assert {d.message.split(": ", 1)[0] for d in found} == {"moves 0-2"}
+
+
+@pytest.mark.parametrize(
+    ("pose", "shape"),
+    [
+        (transl(1e300, 0, 0), Shape("box", np.eye(4), (0.1, 0.1, 0.1))),
+        (transl(1e6, 0, 0), Shape("box", np.eye(4), (0.1, 0.1, 0.1))),
+        (transl(0, 0, -2.5e4), Shape("box", np.eye(4), (5e4, 5e4, 5e4))),
+        (transl(0, 0, -5e19), Shape("box", np.eye(4), (1e20, 1e20, 1e20))),
+        (transl(1e300, 0, 0), Shape("sphere", np.eye(4), (1e300,))),
+    ],
+)
+def test_a_body_beyond_exact_distances_is_an_error(
+    cell: Station, pose: np.ndarray, shape: Shape
+) -> None:
+    """Bodies beyond 1 km of the robot, where coal's distances lose their accuracy (a box of
+    50 km side 10 mm below a link is reported touching), cannot be checked: an error at the
+    first motion, not a pass (and no overflow warning either)."""
+    station = _with(cell, StationObject("far", "fixture", pose, (shape,)))
+    found = check_collisions(_compile(station, _ptp(SWEEP_FROM, 2), _ptp(SWEEP_TO, 3)))
+    assert _found(found) == [("collision_unchecked", 0, 2)]
+    assert found[0].severity == "error"
+    assert found[0].message.startswith("collisions with fixture 'far' cannot be checked")
+
+
+def test_a_distance_that_is_not_a_number_is_an_error(
+    cell: Station, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    compiled = _compile(cell, _ptp(SWEEP_FROM, 2), _ptp(SWEEP_TO, 3))
+    monkeypatch.setattr(Scene, "distance", lambda self, pair: float("nan"))
+    for mode in ("advance", "samples"):
+        found = check_collisions(compiled, CollisionOptions(mode=mode))  # type: ignore[arg-type]
+        assert found and {d.kind for d in found} == {"collision_unchecked"}
+        assert all(d.severity == "error" and "not a number" in d.message for d in found)
+
+
+class _Constant:
+    """A scene whose one pair is at the distances given, in turn (the last one repeats)."""
+
+    def __init__(self, *distances: float) -> None:
+        self.distances = list(distances)
+
+    def place(self, chain: np.ndarray) -> None:
+        pass
+
+    def distance(self, pair: object) -> float:
+        return self.distances.pop(0) if len(self.distances) > 1 else self.distances[0]
+
+
+def test_the_advancement_gives_up_instead_of_running_for_ever(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A pair that grazes contact along a path whose displacement bound is huge (1e20 m): each
+    step is half a tolerance, so proving the path would take 1e24 evaluations; and once the
+    bound is that large a step no longer moves the frontier at all."""
+    from olp.collision import advance as advance_module
+    from olp.collision.advance import Unresolved
+
+    run = path_run([np.array([[0.0], [1.0], [2.0]])], lambda q: q)
+    cum = np.array([0.0, 1e20, 2e20])
+    lower, upper = -1e-4, -5e-5
+    monkeypatch.setattr(advance_module, "MAX_EVALUATIONS", 1000)
+    with pytest.raises(Unresolved, match="no proof after 1000 distance evaluations"):
+        advance(_Constant(0.0), None, run, lower, upper, cum)  # type: ignore[arg-type]
+    with pytest.raises(Unresolved, match="below floating-point resolution") as caught:
+        advance(_Constant(1.5e20, 0.0), None, run, lower, upper, cum)  # type: ignore[arg-type]
+    assert caught.value.where.motion == 0 and 0.5 < caught.value.where.fraction < 1.0
