@@ -9,6 +9,34 @@ Each checked :class:`BodyPair` carries ``weights`` (nq,): a bound on how far any
 can move relative to the other per unit of each chain joint (m/rad for revolute joints, m/m for
 prismatic ones). For a joint-space step ``dq`` no point moves further than ``|dq| · weights`` —
 see :class:`DisplacementBound` for the derivation.
+
+Which pairs are checked
+-----------------------
+Every body that can move relative to another is checked against it, except (and nothing here
+depends on the clearance a user asks for, so a larger clearance only adds margin):
+
+* bodies on the same or on neighbouring joints (one rigid body, or two links sharing a joint);
+* link pairs the robot library declares (``allowed_pairs`` in ``stations/robots/...``): the
+  simplified shapes of some links overlap in every position by construction, and the library
+  entry states each such pair with its reason, instead of olp guessing them from one pose;
+* pairs of body names in :attr:`PairRules.allowed` (the station's ``allowed_pairs``,
+  ``--allow-contact``): the user's decision;
+* link and tool shapes *proven* to overlap in every configuration (:class:`_FixedPoints`): when
+  every joint that moves one body relative to the other turns about an axis through one point
+  ``p`` (a spherical wrist's centre), ``p`` is fixed relative to both bodies, so each shape's
+  signed distance from ``p`` never changes. If ``depth_a(p) + depth_b(p) > 0`` (depth: how far
+  ``p`` lies inside a shape, negative outside), then at every configuration the shapes overlap by
+  at least that sum: the one ``p`` lies deeper in contains a ball about ``p`` that holds the
+  other's nearest point to ``p``. This is decided per pair of shapes, so a tool whose bracket
+  always overlaps the wrist is still checked with its other shapes;
+* by choice of the caller (:attr:`PairRules.home_contacts`, off by default): link and tool pairs
+  that overlap at the robot's home position. One pose proves nothing about others, so this is
+  never automatic.
+
+Bodies farther than :data:`MAX_REACH_M` from the origin of their frame are left out of the scene
+and listed in :attr:`Scene.unchecked`: beyond that, coal's distances lose the accuracy the check
+needs (a box of 50 km side 10 mm below a link is reported touching), so the pass reports them
+instead.
 """
 
 from __future__ import annotations
@@ -31,6 +59,17 @@ Role = Literal["link", "tool", "carried", "part", "fixture"]
 PairKind = Literal["collision", "self_collision"]
 
 _ROBOT_SIDE: frozenset[str] = frozenset({"link", "tool", "carried"})
+_FIXED_SHAPES: frozenset[str] = frozenset({"link", "tool"})
+
+MAX_REACH_M = 1e3
+"""Largest distance (m) of a body's points from the origin of the frame it moves with (the robot's
+base for a part or fixture) that is checked. Measured with coal 3.0, a capsule 10 mm above a box
+of side 30 km is 10 mm away to 1e-12 m; at a side of 50 km coal reports it touching. 1 km covers
+any cell and leaves a factor 30."""
+
+ALWAYS_IN_CONTACT_M = 1e-6
+"""Overlap (m) two shapes must be proven to keep in every configuration to go unchecked: a
+micrometre above zero, so that rounding in coal's point depths cannot turn a gap into a proof."""
 
 
 class UnsupportedChain(ValueError):
@@ -82,20 +121,19 @@ class Placed:
 
 @dataclass(frozen=True, slots=True)
 class PairRules:
-    """Which pairs are not checked.
+    """Which pairs are not checked, besides those the module text lists as never checked.
 
     ``allowed``: pairs of body names (either order) never checked. ``tool_touches_parts``: the
     tool (not the links) may touch and enter parts. ``self_collision``: check the robot's bodies
-    against each other (adjacent joints never are). ``home_contacts``: the robot-side pairs
-    (links and tool) closer than ``contact_below`` (m) at the robot's home position are
-    allowed, as the overlapping capsules of a simplified collision model are.
+    against each other. ``home_contacts``: also leave out the link and tool pairs that overlap
+    (signed distance below zero) at the robot's home position — a caller's choice, off by
+    default, and independent of any clearance.
     """
 
     allowed: frozenset[frozenset[str]] = frozenset()
     tool_touches_parts: bool = True
     self_collision: bool = True
-    home_contacts: bool = True
-    contact_below: float = 0.0
+    home_contacts: bool = False
 
 
 class Scene:
@@ -107,6 +145,7 @@ class Scene:
         geometry: Any,
         bodies: Sequence[Body],
         chain_joints: Callable[[FloatArray], FloatArray],
+        unchecked: Sequence[tuple[str, float]] = (),
     ) -> None:
         import pinocchio as pin
 
@@ -115,6 +154,8 @@ class Scene:
         self.model = model
         self.geometry = geometry
         self.bodies = tuple(bodies)
+        self.unchecked = tuple(unchecked)
+        """(label, reach in m) of the bodies left out for lying beyond :data:`MAX_REACH_M`."""
         self.pairs: tuple[BodyPair, ...] = ()
         self._pin = pin
         self._data = model.createData()
@@ -170,12 +211,19 @@ def build_scene(
     world = inv(robot.base)
     for obj in objects:
         builder.add(dataclasses.replace(obj, pose=world @ obj.pose), f"{obj.role} {obj.name!r}", 0)
-    scene = Scene(model, builder.geometry, builder.bodies, robot.kinematics.chain_joints)
+    chain = robot.kinematics.chain_joints
+    scene = Scene(model, builder.geometry, builder.bodies, chain, builder.unchecked)
     bound = DisplacementBound(model, robot)
-    candidates = _candidate_pairs(model, builder.bodies, rules)
-    scene.finalize([_register(scene, i, j, bound) for i, j in candidates])
+    links = frozenset(frozenset(p) for p in robot.allowed_pairs)
+    fixed = _FixedPoints(scene)
+    pairs = []
+    for i, j in _candidate_pairs(model, builder.bodies, rules, links):
+        unproven = fixed.unproven(scene.bodies[i], scene.bodies[j])
+        if unproven:
+            pairs.append(_register(scene, i, j, unproven, bound))
+    scene.finalize(pairs)
     if rules.home_contacts and rules.self_collision:
-        scene.pairs = _without_home_contacts(scene, robot, rules.contact_below)
+        scene.pairs = _without_home_contacts(scene, robot)
     return scene
 
 
@@ -185,19 +233,25 @@ class _Builder:
 
     geometry: Any
     bodies: list[Body] = field(default_factory=list)
+    unchecked: list[tuple[str, float]] = field(default_factory=list)
 
     def add(self, placed: Placed, label: str, joint: int) -> None:
-        """Add a body made of ``placed.shapes`` at ``placed.pose`` in ``joint``'s frame."""
+        """Add a body made of ``placed.shapes`` at ``placed.pose`` in ``joint``'s frame, unless
+        it reaches beyond :data:`MAX_REACH_M` (then it is listed in ``unchecked``)."""
         import pinocchio as pin
 
         if not placed.shapes:
+            return
+        with np.errstate(over="ignore", invalid="ignore"):  # 1e300 m squared: inf, then refused
+            radius = max(reach(s, placed.pose) for s in placed.shapes)
+        if not radius <= MAX_REACH_M:
+            self.unchecked.append((label, radius))
             return
         ids = []
         for k, shape in enumerate(placed.shapes):
             placement = pin.SE3(placed.pose @ shape.pose)
             obj = pin.GeometryObject(f"{placed.name}#{k}", joint, placement, coal_geometry(shape))
             ids.append(self.geometry.addGeometryObject(obj))
-        radius = max(reach(s, placed.pose) for s in placed.shapes)
         self.bodies.append(Body(placed.name, label, placed.role, joint, tuple(ids), radius))
 
 
@@ -216,35 +270,44 @@ def _link_frames(model: Any, robot: Robot) -> dict[str, tuple[int, FloatArray]]:
     return dict(sorted(out.items(), key=lambda item: (item[1][0], item[0])))
 
 
-def _register(scene: Scene, i: int, j: int, bound: DisplacementBound) -> BodyPair:
+def _register(
+    scene: Scene, i: int, j: int, shapes: Sequence[tuple[int, int]], bound: DisplacementBound
+) -> BodyPair:
+    """Register the geometry pairs ``shapes`` of bodies i and j as one checked pair."""
     import pinocchio as pin
 
     a, b = scene.bodies[i], scene.bodies[j]
     if a.joint == 0:
         i, j, a, b = j, i, b, a
     start = len(scene.geometry.collisionPairs)
-    for ga in a.geometries:
-        for gb in b.geometries:
-            scene.geometry.addCollisionPair(pin.CollisionPair(ga, gb))
-    count = len(a.geometries) * len(b.geometries)
+    for ga, gb in shapes:
+        scene.geometry.addCollisionPair(pin.CollisionPair(ga, gb))
     kind: PairKind = "self_collision" if b.role in _ROBOT_SIDE else "collision"
-    return BodyPair(i, j, kind, tuple(range(start, start + count)), bound.pair(a, b))
+    return BodyPair(i, j, kind, tuple(range(start, start + len(shapes))), bound.pair(a, b))
 
 
-def _candidate_pairs(model: Any, bodies: Sequence[Body], rules: PairRules) -> list[tuple[int, int]]:
-    """Body index pairs to check: something moving against anything it could meet."""
+def _candidate_pairs(
+    model: Any, bodies: Sequence[Body], rules: PairRules, links: frozenset[frozenset[str]]
+) -> list[tuple[int, int]]:
+    """Body index pairs to check: something moving against anything it could meet.
+    ``links``: the robot's allowed link pairs (they name links only, never a station body)."""
     out = []
     for i, a in enumerate(bodies):
         for j in range(i + 1, len(bodies)):
             b = bodies[j]
-            if _checked(model, a, b, rules):
+            if _checked(model, a, b, rules, links):
                 out.append((i, j))
     return out
 
 
-def _checked(model: Any, a: Body, b: Body, rules: PairRules) -> bool:
-    if a.joint == b.joint or frozenset((a.name, b.name)) in rules.allowed:
+def _checked(
+    model: Any, a: Body, b: Body, rules: PairRules, links: frozenset[frozenset[str]]
+) -> bool:
+    names = frozenset((a.name, b.name))
+    if a.joint == b.joint or names in rules.allowed:
         return False  # one rigid body (or two fixed ones), or declared allowed
+    if a.role == b.role == "link" and names in links:
+        return False  # the robot library: overlapping by construction
     robot_side = a.role in _ROBOT_SIDE and b.role in _ROBOT_SIDE
     if robot_side:
         adjacent = model.parents[a.joint] == b.joint or model.parents[b.joint] == a.joint
@@ -253,16 +316,88 @@ def _checked(model: Any, a: Body, b: Body, rules: PairRules) -> bool:
     return not (rules.tool_touches_parts and roles == {"tool", "part"})
 
 
-def _without_home_contacts(scene: Scene, robot: Robot, below: float) -> tuple[BodyPair, ...]:
-    """The scene's pairs without the link/tool pairs closer than ``below`` (m) at home."""
+def _without_home_contacts(scene: Scene, robot: Robot) -> tuple[BodyPair, ...]:
+    """The scene's pairs without the link/tool pairs that overlap at the robot's home."""
     scene.place(np.asarray(robot.kinematics.chain_joints(robot.home), dtype=np.float64))
-    fixed = {"link", "tool"}
 
     def touching(pair: BodyPair) -> bool:
         roles = {scene.bodies[pair.first].role, scene.bodies[pair.second].role}
-        return pair.kind == "self_collision" and roles <= fixed and scene.distance(pair) < below
+        return pair.kind == "self_collision" and roles <= _FIXED_SHAPES and scene.distance(pair) < 0
 
     return tuple(p for p in scene.pairs if not touching(p))
+
+
+class _FixedPoints:
+    """Shape pairs of two robot-side bodies proven to overlap in every configuration (the
+    fixed-point argument of the module text).
+
+    The geometry is taken at the chain's neutral configuration: which point the joints between
+    two bodies leave fixed, and each shape's depth at that point, are the same in every
+    configuration, so any one configuration serves (it is not a sample of many).
+    """
+
+    def __init__(self, scene: Scene) -> None:
+        import pinocchio as pin
+
+        self._scene = scene
+        model = scene.model
+        data = model.createData()
+        # World-frame joint twists (v at the world origin, then ω) as columns (6, nv).
+        self._twists = np.array(pin.computeJointJacobians(model, data, pin.neutral(model)))
+        gdata = pin.GeometryData(scene.geometry)
+        pin.updateGeometryPlacements(model, data, scene.geometry, gdata)
+        self._placements = [gdata.oMg[k] for k in range(scene.geometry.ngeoms)]
+
+    def unproven(self, a: Body, b: Body) -> list[tuple[int, int]]:
+        """The shape pairs (geometry ids) of bodies ``a`` and ``b`` not proven in contact."""
+        shapes = [(ga, gb) for ga in a.geometries for gb in b.geometries]
+        if a.role not in _FIXED_SHAPES or b.role not in _FIXED_SHAPES:
+            return shapes
+        point = self._fixed_point(set(self._chain(a.joint)) ^ set(self._chain(b.joint)))
+        if point is None:
+            return shapes
+        depth = {g: self._depth(g, point) for g in (*a.geometries, *b.geometries)}
+        return [(ga, gb) for ga, gb in shapes if depth[ga] + depth[gb] <= ALWAYS_IN_CONTACT_M]
+
+    def _chain(self, joint: int) -> list[int]:
+        out = []
+        while joint > 0:
+            out.append(joint)
+            joint = self._scene.model.parents[joint]
+        return out
+
+    def _fixed_point(self, joints: set[int]) -> FloatArray | None:
+        """The point (3,) that no joint in ``joints`` moves: ``v + ω × p = 0`` for every twist
+        column, solved in least squares; None if it does not hold (to 1e-9 m/rad), e.g. for
+        parallel axes or a prismatic joint."""
+        if not joints:
+            return None
+        model = self._scene.model
+        columns = [
+            self._twists[:, model.joints[j].idx_v : model.joints[j].idx_v + model.joints[j].nv]
+            for j in sorted(joints)
+        ]
+        twists = np.concatenate(columns, axis=1).T
+        lhs = np.concatenate([_skew(w) for w in twists[:, 3:]])
+        rhs = -twists[:, :3].reshape(-1)
+        point = np.linalg.lstsq(lhs, rhs, rcond=None)[0]
+        return point if np.max(np.abs(lhs @ point - rhs)) <= 1e-9 else None
+
+    def _depth(self, geometry: int, point: FloatArray) -> float:
+        """How far ``point`` (3,) lies inside a shape (m; negative: its distance outside)."""
+        import coal
+
+        placement = self._placements[geometry]
+        shape = coal.Transform3s(placement.rotation, placement.translation)
+        at = coal.Transform3s(np.eye(3), point)
+        obj = self._scene.geometry.geometryObjects[geometry].geometry
+        result = coal.DistanceResult()
+        return -coal.distance(obj, shape, coal.Sphere(0.0), at, coal.DistanceRequest(), result)
+
+
+def _skew(w: FloatArray) -> FloatArray:
+    """The matrix (3, 3) of ``p -> w × p``."""
+    return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
 
 
 # --------------------------------------------------------------------------------------------

@@ -6,10 +6,15 @@ What is checked (coal through pinocchio's ``GeometryModel``; meshes as convex hu
   fixtures (kind ``collision``);
 * the robot's links, tool and carried parts against each other (kind ``self_collision``), except
   bodies on the same or on adjacent joints (the tool and a carried part sit on the last joint, so
-  they may touch the last two links), pairs already closer than the clearance at the home
-  position (the overlapping capsules of a simplified model) and declared ``allowed_pairs``;
+  they may touch the last two links), the link pairs the robot library declares (capsules that
+  overlap by construction), link and tool shapes proven to overlap in every configuration (a
+  tool's bracket inside the wrist's capsule) — see :mod:`olp.collision.scene`;
+* never the pairs the station's ``allowed_pairs`` or :attr:`CollisionOptions.allowed_pairs` name;
 * by default the tool may touch and enter *parts* (machining, welding, screwing); it is checked
   against fixtures.
+
+The set of checked pairs does not depend on the clearance: a larger ``clearance_m`` only adds
+margin, so a program that fails at one clearance fails at every larger one.
 
 Along every motion the piecewise-linear joint path between the resolve pass's samples is proven
 free by conservative advancement (:mod:`olp.collision.advance`): if nothing is reported, every
@@ -25,10 +30,15 @@ Rounded corners (zones) are not modelled: the checked path is the programmed one
 Pick and place: an :class:`Attachment` makes the tool carry a station part from one instruction
 to another; the part keeps the pose relative to the flange it had when gripped and stays where
 it was let go.
+
+What cannot be checked is an error diagnostic (kind ``collision_unchecked``), never a pass: a
+body beyond :data:`olp.collision.scene.MAX_REACH_M`, a distance that is not a number, or a
+path the advancement cannot prove free within its evaluation budget.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Literal
@@ -37,11 +47,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from olp.diagnostics import Diagnostic
+from olp.errors import UsageError
 from olp.geometry import inv
 from olp.ir import FLANGE, Tool, is_motion
 
 if TYPE_CHECKING:
-    from olp.collision.advance import Hit
+    from olp.collision.advance import Hit, Unresolved
     from olp.collision.scene import Placed, Scene
     from olp.passes.resolve import CompiledProgram, Step
     from olp.station.model import Station
@@ -65,16 +76,23 @@ class Attachment:
 class CollisionOptions:
     """Settings of the collision check.
 
-    ``clearance_m``: bodies closer than this (m) collide (0: only overlap counts).
-    ``tolerance_m``: the resolution: a pair closer than ``clearance_m - tolerance_m`` anywhere
-    on a motion is always reported; one that stays above ``clearance_m - tolerance_m / 2`` never
-    is (so parts resting on fixtures do not collide). ``allowed_pairs``: pairs of body names
-    never checked (robot links by link name, e.g. ``"link_3"``; the tool by its station name;
-    parts and fixtures by name). ``self_collision``: check the robot's bodies against each other.
-    ``tool_touches_parts``: the tool may touch and enter parts. ``home_contacts``: allow the
-    robot-side pairs already in contact at the home position. ``attachments``: parts carried by
-    the tool (pick and place). ``mode``: ``"advance"`` proves the path between samples free;
+    ``clearance_m``: bodies closer than this (m) collide (0: only overlap counts); it adds margin
+    to every checked pair and never changes which pairs are checked. ``tolerance_m``: the
+    resolution (within :data:`TOLERANCE_RANGE_M`): a pair closer than ``clearance_m -
+    tolerance_m`` anywhere on a motion is always reported; one that stays above ``clearance_m -
+    tolerance_m / 2`` never is (so parts resting on fixtures do not collide).
+
+    ``allowed_pairs``: pairs of body names never checked, added to the station's (robot links by
+    link name, e.g. ``"link_3"``; the tool by its station name; parts and fixtures by name).
+    ``self_collision``: check the robot's bodies against each other. ``tool_touches_parts``: the
+    tool may touch and enter parts. ``home_contacts``: also allow the link and tool pairs that
+    overlap at the home position (off by default: one pose does not show that two bodies always
+    touch; the robot library declares the pairs that do). ``attachments``: parts carried by the
+    tool (pick and place). ``mode``: ``"advance"`` proves the path between samples free;
     ``"samples"`` checks the resolve samples only (a reference that misses thin obstacles).
+
+    Raises :class:`~olp.errors.UsageError` for a clearance that is negative or not finite, a
+    tolerance outside :data:`TOLERANCE_RANGE_M`, or an unknown mode.
     """
 
     clearance_m: float = 0.0
@@ -82,15 +100,29 @@ class CollisionOptions:
     allowed_pairs: tuple[tuple[str, str], ...] = ()
     self_collision: bool = True
     tool_touches_parts: bool = True
-    home_contacts: bool = True
+    home_contacts: bool = False
     attachments: tuple[Attachment, ...] = ()
     mode: Literal["advance", "samples"] = "advance"
 
     def __post_init__(self) -> None:
-        if not self.tolerance_m > 0:
-            raise ValueError("CollisionOptions.tolerance_m must be positive")
-        if self.clearance_m < 0:
-            raise ValueError("CollisionOptions.clearance_m must not be negative")
+        if not (math.isfinite(self.clearance_m) and self.clearance_m >= 0):
+            raise UsageError(
+                f"the collision clearance must be a finite distance >= 0, got {self.clearance_m}"
+            )
+        low, high = TOLERANCE_RANGE_M
+        if not low <= self.tolerance_m <= high:
+            raise UsageError(
+                f"the collision tolerance must lie in {low * 1000:g}..{high * 1000:g} mm, "
+                f"got {self.tolerance_m * 1000:g} mm"
+            )
+        if self.mode not in ("advance", "samples"):
+            raise UsageError(f"collision mode must be 'advance' or 'samples', got {self.mode!r}")
+
+
+TOLERANCE_RANGE_M = (1e-6, 1e-2)
+"""Allowed ``tolerance_m`` (m). Below a micrometre the tolerance is finer than coal's distances
+and the advancement crawls (up to ``2 c / tolerance`` evaluations); above 10 mm an overlap that
+deep could pass unreported, which is a disabled check rather than a resolution."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -126,16 +158,19 @@ def check_collisions_with_stats(
         message = f"collisions not checked: {exc}"
         return [Diagnostic("warning", "collision_unchecked", message)], CollisionStats()
     found: list[_Found] = []
+    unresolved: list[Diagnostic] = []
     stats = CollisionStats()
     for run in runs:
-        hits, run_stats = _check_run(run, opts)
+        hits, failed, run_stats = _check_run(run, opts)
         found.extend(hits)
+        unresolved.extend(failed)
         stats = CollisionStats(
             stats.evaluations + run_stats.evaluations,
             stats.rows + run_stats.rows,
             max(stats.pairs, run_stats.pairs),
         )
-    return _bodiless_tools(compiled) + setup + _diagnostics(found, opts.clearance_m), stats
+    checked = _diagnostics(found, opts.clearance_m)
+    return _bodiless_tools(compiled) + setup + unresolved + checked, stats
 
 
 # --------------------------------------------------------------------------------------------
@@ -175,6 +210,7 @@ def _runs(compiled: CompiledProgram, opts: CollisionOptions) -> tuple[list[_Run]
     )
     scenes: dict[tuple[object, ...], Scene] = {}
     runs: list[_Run] = []
+    unchecked: dict[str, Diagnostic] = {}
     last = b""
     motions = (s for s in compiled.steps if is_motion(s.instruction))
     for ordinal, step in enumerate(motions):
@@ -187,13 +223,28 @@ def _runs(compiled: CompiledProgram, opts: CollisionOptions) -> tuple[list[_Run]
         scene = scenes.get(key)
         if scene is None:
             scene = scenes[key] = _scene(station, step, world, opts)
+            for label, radius in scene.unchecked:
+                unchecked.setdefault(label, _too_far(label, radius, step))
         if changed or not runs or runs[-1].scene is not scene or path[0].tobytes() != last:
             runs.append(_Run(scene))
         runs[-1].steps.append(step)
         runs[-1].ordinals.append(ordinal)
         last = path[-1].tobytes()
         world.joints = path[-1]
-    return runs, _unknown_parts(compiled, opts)
+    return runs, _unknown_parts(compiled, opts) + list(unchecked.values())
+
+
+def _too_far(label: str, radius: float, step: Step) -> Diagnostic:
+    """The error for a body the scene left out (beyond ``MAX_REACH_M``), at its first motion."""
+    from olp.collision.scene import MAX_REACH_M
+
+    message = (
+        f"collisions with {label} cannot be checked: it lies up to {radius:.3g} m from the "
+        f"robot, beyond the {MAX_REACH_M:g} m within which distances are exact"
+    )
+    hint = "check the station's units and poses for this body"
+    span = step.instruction.span
+    return Diagnostic("error", "collision_unchecked", message, span, step.index, hint=hint)
 
 
 def _unknown_parts(compiled: CompiledProgram, opts: CollisionOptions) -> list[Diagnostic]:
@@ -292,11 +343,10 @@ def _scene(station: Station, step: Step, world: _World, opts: CollisionOptions) 
         Placed(n, shapes[n].kind, p, shapes[n].shapes) for n, p in sorted(world.objects.items())
     ]
     rules = PairRules(
-        allowed=frozenset(frozenset(p) for p in opts.allowed_pairs),
+        allowed=frozenset(frozenset(p) for p in (*station.allowed_pairs, *opts.allowed_pairs)),
         tool_touches_parts=opts.tool_touches_parts,
         self_collision=opts.self_collision,
         home_contacts=opts.home_contacts,
-        contact_below=opts.clearance_m - opts.tolerance_m / 2,
     )
     return build_scene(station.robot, tool, carried, objects, rules)
 
@@ -317,31 +367,63 @@ class _Found:
     hit: Hit
 
 
-def _check_run(run: _Run, opts: CollisionOptions) -> tuple[list[_Found], CollisionStats]:
-    from olp.collision.advance import advance, cumulative_bounds, path_run, sample_hits
+def _check_run(
+    run: _Run, opts: CollisionOptions
+) -> tuple[list[_Found], list[Diagnostic], CollisionStats]:
+    """The hits of every pair along a run, and an error for each pair that could not be proven
+    free (:class:`~olp.collision.advance.Unresolved`)."""
+    from olp.collision.advance import (
+        Unresolved,
+        advance,
+        cumulative_bounds,
+        path_run,
+        sample_hits,
+    )
 
     scene = run.scene
     path = path_run([s.path for s in run.steps if s.path is not None], scene.chain_joints)
     lower = opts.clearance_m - opts.tolerance_m
     upper = opts.clearance_m - opts.tolerance_m / 2
     found: list[_Found] = []
+    failed: list[Diagnostic] = []
     evaluations = 0
     if not scene.pairs:
-        return found, CollisionStats(0, len(path.joints), 0)
+        return found, failed, CollisionStats(0, len(path.joints), 0)
     unique, inverse = np.unique([p.weights for p in scene.pairs], axis=0, return_inverse=True)
     which = inverse.reshape(-1)
     bounds = cumulative_bounds(path, unique) if opts.mode == "advance" else unique[:, :0]
     for k, pair in enumerate(scene.pairs):
-        if opts.mode == "samples":
-            hits, count = sample_hits(scene, pair, path, upper)
-        else:
-            hits, count = advance(scene, pair, path, lower, upper, bounds[int(which[k])])
-        evaluations += count
         first, second = scene.name_of(pair)
+        try:
+            if opts.mode == "samples":
+                hits, count = sample_hits(scene, pair, path, upper)
+            else:
+                hits, count = advance(scene, pair, path, lower, upper, bounds[int(which[k])])
+        except Unresolved as exc:
+            failed.append(_unresolved(run, first, second, exc))
+            evaluations += exc.evaluations
+            continue
+        evaluations += count
         for hit in hits:
             step, ordinal = run.steps[hit.motion], run.ordinals[hit.motion]
             found.append(_Found(first, second, pair.kind, ordinal, step, hit))
-    return found, CollisionStats(evaluations, len(path.joints), len(scene.pairs))
+    return found, failed, CollisionStats(evaluations, len(path.joints), len(scene.pairs))
+
+
+def _unresolved(run: _Run, first: str, second: str, exc: Unresolved) -> Diagnostic:
+    step = run.steps[exc.where.motion]
+    message = (
+        f"{first} against {second} cannot be checked from {exc.where.fraction:.0%} of the move "
+        f"on: {exc.reason}"
+    )
+    return Diagnostic(
+        "error",
+        "collision_unchecked",
+        message,
+        step.instruction.span,
+        step.index,
+        joints=exc.where.joints,
+    )
 
 
 # --------------------------------------------------------------------------------------------
@@ -366,7 +448,8 @@ def _diagnostics(found: Sequence[_Found], clearance: float) -> list[Diagnostic]:
 _HINTS = {
     "collision": "add a via point or change the approach so the path goes around the obstacle, "
     "or move the obstacle",
-    "self_collision": "use another robot configuration (IK branch) or add a via point",
+    "self_collision": "use another robot configuration (IK branch) or add a via point; if the "
+    "two shapes touch by construction, declare the pair in allowed_pairs (station or robot file)",
 }
 
 

@@ -355,6 +355,7 @@ class RobotModel:
     controller_base: np.ndarray
     collision: tuple[Shape, ...]
     sources: tuple[str, ...] = ()
+    allowed_pairs: tuple[tuple[str, str], ...] = ()
 
     def place(self, base: np.ndarray | None = None, **changes: Any) -> Robot:
         """The model as a :class:`Robot` at ``base`` (4, 4) in the world (default: origin)."""
@@ -368,6 +369,7 @@ class RobotModel:
             flange_in_tool0=vendors.flange_in_tool0(self.vendor),
             controller_base=self.controller_base,
             collision=self.collision,
+            allowed_pairs=self.allowed_pairs,
         )
 
 
@@ -407,6 +409,7 @@ def _model(doc: _Doc, value: dict[str, Any], path: Path_) -> RobotModel:
         controller_base=_pose(doc, value.get("controller_base"), (*path, "controller_base")),
         collision=_shapes(doc, value.get("collision"), (*path, "collision"), links),
         sources=sources,
+        allowed_pairs=_pairs(doc, value.get("allowed_pairs"), (*path, "allowed_pairs"), links),
     )
 
 
@@ -570,6 +573,7 @@ def load_station(path: str | Path) -> Station:
         *_objects(doc, top.get("parts"), ("parts",), "part", frames, seen),
         *_objects(doc, top.get("fixtures"), ("fixtures",), "fixture", frames, seen),
     )
+    names = {"base", *(s.link for s in robot.collision), *tools, *seen}
     return Station(
         name=str(top.get("name") or path.stem),
         robot=robot,
@@ -579,7 +583,22 @@ def load_station(path: str | Path) -> Station:
         tool_bodies=bodies,
         frame_parents=parents,
         objects=objects,
+        allowed_pairs=_pairs(doc, top.get("allowed_pairs"), ("allowed_pairs",), names),
     )
+
+
+def _pairs(doc: _Doc, value: Any, path: Path_, names: set[str]) -> tuple[tuple[str, str], ...]:
+    """``allowed_pairs``: a list of [name, name], each one of ``names``."""
+    out = []
+    for i, pair in enumerate(_list(doc, value, path)):
+        if not isinstance(pair, list) or len(pair) != 2 or pair[0] == pair[1]:
+            raise doc.error((*path, i), f"expected two different names [A, B], got {pair!r}")
+        for k, name in enumerate(pair):
+            if not isinstance(name, str) or name not in names:
+                known = ", ".join(sorted(names))
+                raise doc.error((*path, i, k), f"unknown body {name!r} (known: {known})")
+        out.append((str(pair[0]), str(pair[1])))
+    return tuple(out)
 
 
 def _station_robot(doc: _Doc, value: Any, path: Path_, station_path: Path) -> Robot:

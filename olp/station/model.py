@@ -132,7 +132,9 @@ class Robot:
     frame (identity except for vendors whose flange is not Z-out, see :mod:`olp.vendors`).
     ``controller_base``: the controller's own robot base frame (KUKA ROBROOT, ABB base, Fanuc
     World at axis-2 height, UR Base) in the kinematic base frame. ``collision``: shapes in link
-    frames (``Shape.link``), simple approximations of the links.
+    frames (``Shape.link``), simple approximations of the links. ``allowed_pairs``: pairs of link
+    names whose shapes overlap in every position by construction of that approximation (the
+    robot library states each with its reason); they are never checked against each other.
     """
 
     name: str
@@ -144,6 +146,7 @@ class Robot:
     flange_in_tool0: FloatArray = field(default_factory=lambda: np.eye(4))
     controller_base: FloatArray = field(default_factory=lambda: np.eye(4))
     collision: tuple[Shape, ...] = ()
+    allowed_pairs: tuple[tuple[str, str], ...] = ()
 
     @property
     def dof(self) -> int:
@@ -214,7 +217,9 @@ class StationObject:
 @dataclass(frozen=True, slots=True, eq=False)
 class Station:
     """A robot cell: the robot, named tools (TCP in flange) and frames (pose in world), the
-    tools' bodies, each frame's parent frame, and the parts and fixtures."""
+    tools' bodies, each frame's parent frame, and the parts and fixtures. ``allowed_pairs``: pairs
+    of body names (robot links, tools, parts, fixtures) the station allows to touch: never checked
+    for collisions."""
 
     name: str
     robot: Robot
@@ -224,6 +229,7 @@ class Station:
     tool_bodies: Mapping[str, ToolBody] = field(default_factory=dict)
     frame_parents: Mapping[str, str] = field(default_factory=dict)
     objects: tuple[StationObject, ...] = ()
+    allowed_pairs: tuple[tuple[str, str], ...] = ()
 
     def tool(self, ref: Tool) -> Tool | None:
         """The station's definition for a tool reference (by name, then number), or None."""

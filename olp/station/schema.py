@@ -135,6 +135,17 @@ _KINEMATICS = _object(
     "dh: rows; urdf: file tip [base].",
 )
 
+_PAIRS: dict[str, Any] = {
+    "type": "array",
+    "description": "pairs of bodies never checked against each other (they touch by design)",
+    "items": {
+        "type": "array",
+        "items": {"type": "string", "minLength": 1},
+        "minItems": 2,
+        "maxItems": 2,
+    },
+}
+
 _MODEL_PROPS: dict[str, Any] = {
     "name": {"type": "string"},
     "vendor": {"enum": ["kuka", "abb", "fanuc", "ur"]},
@@ -147,6 +158,7 @@ _MODEL_PROPS: dict[str, Any] = {
         "description": "the controller's robot base frame in the mounting frame",
     },
     "collision": {"type": "array", "items": _ref("shape")},
+    "allowed_pairs": {**_PAIRS, "description": "link pairs whose shapes overlap in every position"},
 }
 
 ROBOT_MODEL = _object(
@@ -226,6 +238,7 @@ STATION: dict[str, Any] = {
             "frames": {"type": "array", "items": _ref("frame")},
             "parts": {"type": "array", "items": _ref("object")},
             "fixtures": {"type": "array", "items": _ref("object")},
+            "allowed_pairs": {**_PAIRS, "description": "links, tools, parts that may touch"},
         },
         ("robot",),
     ),

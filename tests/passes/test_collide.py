@@ -4,6 +4,7 @@ the bound the advancement rests on, and the guarantee itself against dense sampl
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import re
 from pathlib import Path
 
@@ -20,7 +21,7 @@ from olp.geometry import pose_from, rotx, roty, rotz, transl
 from olp.passes.collide import Attachment, CollisionOptions, check_collisions
 from olp.passes.resolve import CompiledProgram, ResolveOptions, resolve
 from olp.station.loader import load_station
-from olp.station.model import Shape, Station, StationObject, ToolBody
+from olp.station.model import Robot, Shape, Station, StationObject, ToolBody
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -314,11 +315,18 @@ def test_the_milling_helix_is_free() -> None:
     # The clamps are 25 mm from the spindle, the cutter 20 mm above the table: with a 30 mm
     # clearance the helix comes too close to each clamp on each of its turns.
     near = check_collisions(compiled, CollisionOptions(clearance_m=0.03))
-    assert {d.kind for d in near} == {"collision"}
+    clamps = [d for d in near if d.kind == "collision"]
     assert all(
-        d.message.startswith("moves ") and "tool 'spindle' hits fixture" in d.message for d in near
+        d.message.startswith("moves ") and "tool 'spindle' hits fixture" in d.message
+        for d in clamps
     )
-    assert sum("clamp" in d.message for d in near) >= 4 * 3
+    assert sum("clamp" in d.message for d in clamps) >= 4 * 3
+    # The margin holds for the robot's own links too: link_2 passes 21.6 mm from the base
+    # capsule at home and stays that close all the way round.
+    assert [d.message for d in near if d.kind != "collision"] == [
+        "moves 0-400: self-collision: robot link_2 hits robot base (closer than 30.0 mm) "
+        "(first at 0% of move 0)"
+    ]
 
 
 def test_a_sweep_in_free_space_is_free(cell: Station) -> None:
@@ -460,3 +468,452 @@ def test_chord_deviation_of_a_linear_move_is_second_order(cell: Station) -> None
         gaps.append(float(np.max(chord_deviation(cell.robot, scene, [path], ROD.pose))))
     assert gaps[1] < 1e-4  # below the default tolerance at the default 5 mm step
     assert 3.0 < gaps[0] / gaps[1] < 5.0  # halving the step quarters the gap
+
+
+# --------------------------------------------------------------------------------------------
+# Which pairs are checked: never a function of the clearance (issue 10, item 1)
+
+# The issue's reproduction: the second move swings link 2 into the base.
+BUMP = (np.radians([0, -90, 90, 0, 30, 0]), np.radians([0, 45, -120, 0, -120, 0]))
+BUMP_SRC = """DEF Bump( )
+PTP {A1 0,A2 -90,A3 90,A4 0,A5 30,A6 0}
+PTP {A1 0,A2 45,A3 -120,A4 0,A5 -120,A6 0}
+END
+"""
+SWEEP_CLEARANCES = (0.0, 1e-3, 0.01, 0.0216, 0.05, 0.1, 1.0, 1e6)
+
+
+def test_a_larger_clearance_fails_the_issue_program_too(tmp_path: Path) -> None:
+    from olp.cli import main
+
+    program = tmp_path / "bump.src"
+    program.write_text(BUMP_SRC)
+    station = str(REPO / "stations" / "kr6_milling_cell.yaml")
+    for clearance in ("0", "100"):
+        assert main(["check", station, str(program), "-q", "--clearance", clearance]) == 1
+
+
+def _hits(diagnostics: list[Diagnostic]) -> set[tuple[str, tuple[str, str], int]]:
+    """(kind, pair, instruction) for every motion a diagnostic covers ("moves 3-5" is three)."""
+    out = set()
+    for d in diagnostics:
+        assert d.index is not None
+        spread = re.match(r"moves (\d+)-(\d+): ", d.message)
+        first, last = (int(spread[1]), int(spread[2])) if spread else (d.index, d.index)
+        pair = _pair_names(re.sub(r" \(closer than [^)]*\)", "", d.message))
+        out |= {(d.kind, pair, k) for k in range(first, last + 1)}
+    return out
+
+
+def _checked_pairs(
+    monkeypatch: pytest.MonkeyPatch, compiled: CompiledProgram, options: CollisionOptions
+) -> tuple[list[Diagnostic], list[tuple[tuple[str, str], tuple[int, ...]]]]:
+    """The diagnostics and every pair (names, geometry pairs) of every scene the pass built."""
+    from olp.collision import scene as scene_module
+
+    built: list[tuple[tuple[str, str], tuple[int, ...]]] = []
+
+    def recording(*args: object, **kwargs: object) -> Scene:
+        scene = build_scene(*args, **kwargs)  # type: ignore[arg-type]
+        built.extend((scene.name_of(p), p.geometry_pairs) for p in scene.pairs)
+        return scene
+
+    monkeypatch.setattr(scene_module, "build_scene", recording)
+    return check_collisions(compiled, options), built
+
+
+def test_the_checked_pairs_do_not_depend_on_the_clearance(
+    cell: Station, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The same pairs at every clearance, and what a clearance reports it reports at every
+    larger one (from half a tolerance up, the advancement's guarantee: below that a near miss
+    inside the tolerance band may go either way)."""
+    compiled = _compile(cell, _ptp(BUMP[0], 2), _ptp(BUMP[1], 3))
+    results = [
+        _checked_pairs(monkeypatch, compiled, CollisionOptions(clearance_m=c))
+        for c in SWEEP_CLEARANCES
+    ]
+    assert ("self_collision", ("robot link_2", "robot base"), 1) in _hits(results[0][0])
+    for (found, pairs), (more, more_pairs) in itertools.pairwise(results):
+        assert more_pairs == pairs == results[0][1]
+        assert _hits(found) <= _hits(more)
+    # At 1000 km every checked pair is too close: each is reported, and no other.
+    reported = {pair for _, pair, _ in _hits(results[-1][0])}
+    assert reported == {names for names, _ in results[0][1]}
+
+
+@pytest.fixture(scope="module")
+def collision_cell() -> Station:
+    return load_station(REPO / "stations" / "kr6_milling_collision_cell.yaml")
+
+
+def test_a_clearance_only_adds_margin_on_random_moves(
+    collision_cell: Station, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Property: random joint moves of the spindle robot, two clearances c and c + gap (gap at
+    least half the tolerance): the same pairs are checked and every hit at c is a hit at
+    c + gap."""
+    from hypothesis import HealthCheck, given, settings
+    from hypothesis import strategies as st
+
+    robot = collision_cell.robot
+    tool = collision_cell.tools["spindle"]
+    tolerance = CollisionOptions().tolerance_m
+    unit = st.floats(0.0, 1.0)
+
+    @settings(
+        max_examples=20,
+        deadline=None,
+        derandomize=True,
+        suppress_health_check=[HealthCheck.function_scoped_fixture],
+    )
+    @given(st.lists(unit, min_size=12, max_size=12), st.floats(0, 0.15), st.floats(0, 0.1))
+    def check(fractions: list[float], clearance: float, gap: float) -> None:
+        low, high = robot.limits.lower * 0.9, robot.limits.upper * 0.9
+        targets = low + np.reshape(fractions, (2, 6)) * (high - low)
+        moves = [
+            ir.JointMove(target=ir.JointTarget(joints=q), tool=tool, span=_span(k + 2))
+            for k, q in enumerate(targets)
+        ]
+        compiled = resolve(ir.Program(name="t", instructions=tuple(moves)), collision_cell)
+        lower = CollisionOptions(clearance_m=clearance)
+        upper = CollisionOptions(clearance_m=clearance + tolerance / 2 + gap)
+        found, pairs = _checked_pairs(monkeypatch, compiled, lower)
+        more, more_pairs = _checked_pairs(monkeypatch, compiled, upper)
+        assert pairs == more_pairs
+        assert _hits(found) <= _hits(more)
+
+    check()
+
+
+def _library() -> list[str]:
+    from olp.station.loader import robot_library
+
+    return robot_library()
+
+
+def _library_robot(name: str) -> Robot:
+    from olp.station.loader import load_library_robot
+
+    return load_library_robot(name).place()
+
+
+@pytest.mark.parametrize("name", _library())
+def test_no_checked_pair_of_a_library_robot_touches_at_home(name: str) -> None:
+    """The library's allowed_pairs name every pair that overlaps by construction: at home all
+    other pairs are apart, so a program starting there is free at clearance 0."""
+    robot = _library_robot(name)
+    scene = build_scene(robot, None, [], [], PairRules())
+    scene.place(robot.kinematics.chain_joints(robot.home))
+    apart = {scene.name_of(p): scene.distance(p) for p in scene.pairs}
+    assert min(apart.values()) > 0.01, apart
+
+
+@pytest.mark.parametrize("name", _library())
+def test_a_library_robots_allowed_pairs_overlap_in_every_position(name: str) -> None:
+    """What each declaration's comment argues: its capsules overlap wherever the joints are."""
+    robot = _library_robot(name)
+    assert robot.allowed_pairs
+    full = build_scene(dataclasses.replace(robot, allowed_pairs=()), None, [], [], PairRules())
+    declared = {frozenset(p) for p in robot.allowed_pairs}
+    pairs = [p for p in full.pairs if frozenset(_body_name(n) for n in full.name_of(p)) in declared]
+    # Some declared pairs are also proven by the fixed-point rule (never in the full scene).
+    samples = np.random.default_rng(2).uniform(robot.limits.lower, robot.limits.upper, (500, 6))
+    for q in samples:
+        full.place(robot.kinematics.chain_joints(q))
+        assert all(full.distance(p) < 0 for p in pairs), q
+
+
+def test_a_robot_pair_declaration_names_links_not_station_bodies() -> None:
+    """The UR5e's [link_2, base] is about its own base capsule: a fixture named "base" that
+    link_2 runs into is still a collision."""
+    station = load_station(REPO / "stations" / "ur5e_screw_cell.yaml")
+    home = station.robot.home
+    reach_out = home + np.radians([0, 60, 0, 0, 0, 0])
+    block_at = station.robot.link_poses(reach_out)["link_3"][:3, 3]
+    block = _box("base", transl(*block_at), (0.1, 0.1, 0.1))
+    moves = [
+        ir.JointMove(target=ir.JointTarget(joints=q), span=_span(k))
+        for k, q in ((2, home), (3, reach_out))
+    ]
+    found = check_collisions(_compile(_with(station, block), *moves))
+    assert any("robot link_2 hits fixture 'base'" in d.message for d in found), found
+
+
+# --------------------------------------------------------------------------------------------
+# Shapes proven to touch everywhere (a tool bracket inside the wrist)
+
+
+def _everything_checked(monkeypatch: pytest.MonkeyPatch) -> None:
+    from olp.collision import scene as scene_module
+
+    def unproven(self: object, a: object, b: object) -> list[tuple[int, int]]:
+        return [(ga, gb) for ga in a.geometries for gb in b.geometries]  # type: ignore[attr-defined]
+
+    monkeypatch.setattr(scene_module._FixedPoints, "unproven", unproven)
+
+
+def _geometry_pairs(scene: Scene) -> dict[tuple[int, int], tuple[str, str]]:
+    out = {}
+    for pair in scene.pairs:
+        for k in pair.geometry_pairs:
+            cp = scene.geometry.collisionPairs[k]
+            out[(cp.first, cp.second)] = scene.name_of(pair)
+    return out
+
+
+def test_the_spindle_bracket_is_proven_inside_the_wrist_and_the_spindle_still_checked(
+    collision_cell: Station,
+) -> None:
+    shapes = collision_cell.tool_bodies["spindle"].shapes
+    scene = build_scene(
+        collision_cell.robot, Placed("spindle", "tool", np.eye(4), shapes), [], [], PairRules()
+    )
+    with_link_4 = [p for p in scene.pairs if scene.name_of(p) == ("robot link_4", "tool 'spindle'")]
+    # bracket, motor housing, cutter: the housing and the cutter stay checked against link_4
+    assert [len(p.geometry_pairs) for p in with_link_4] == [2]
+
+
+@pytest.mark.parametrize("name", _library())
+def test_shapes_proven_in_contact_overlap_in_every_position(
+    name: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Soundness of the fixed-point rule: a tool of random boxes about the flange on every
+    library robot (its own pairs undeclared); every shape pair the rule leaves unchecked
+    overlaps at random configurations by at least the proven depth."""
+    rng = np.random.default_rng(3)
+    robot = dataclasses.replace(_library_robot(name), allowed_pairs=())
+    boxes = tuple(
+        Shape("box", transl(*rng.uniform(-0.12, 0.12, 3)) @ rotz(rng.uniform(0, 3)), (0.06,) * 3)
+        for _ in range(6)
+    )
+    tool = Placed("t", "tool", np.eye(4), boxes)
+    proven = _geometry_pairs(build_scene(robot, tool, [], [], PairRules()))
+    _everything_checked(monkeypatch)
+    full = build_scene(robot, tool, [], [], PairRules())
+    dropped = {k: v for k, v in _geometry_pairs(full).items() if k not in proven}
+    assert dropped  # a spherical wrist's pairs, or the UR's link_2 and base (axes 1 and 2 meet)
+    import coal
+
+    samples = rng.uniform(robot.limits.lower, robot.limits.upper, (200, robot.dof))
+    for q in samples:
+        full.place(robot.kinematics.chain_joints(q))
+        for a, b in dropped:
+            placement = [full._gdata.oMg[g] for g in (a, b)]
+            shape = [full.geometry.geometryObjects[g].geometry for g in (a, b)]
+            d = coal.distance(
+                shape[0],
+                coal.Transform3s(placement[0].rotation, placement[0].translation),
+                shape[1],
+                coal.Transform3s(placement[1].rotation, placement[1].translation),
+                coal.DistanceRequest(),
+                coal.DistanceResult(),
+            )
+            assert d < 0, (dropped[(a, b)], q)
+
+
+def test_pairs_whose_axes_do_not_meet_are_not_proven(cell: Station) -> None:
+    """The KR 6's link_2 and link_4 overlap by construction, but axes 3 and 4 do not meet (a2):
+    no fixed point, so only the library's declaration leaves them unchecked."""
+    robot = dataclasses.replace(cell.robot, allowed_pairs=())
+    scene = build_scene(robot, None, [], [], PairRules())
+    names = {scene.name_of(p) for p in scene.pairs}
+    assert ("robot link_2", "robot link_4") in names
+    assert ("robot link_4", "robot link_6") not in names  # axes 5 and 6 meet at the wrist centre
+
+
+# --------------------------------------------------------------------------------------------
+# What the station and the caller allow
+
+
+def _station_file(tmp_path: Path, extra: str) -> Path:
+    path = tmp_path / "cell.yaml"
+    path.write_text(f"name: cell\nrobot: {{model: kuka/kr6_r900_sixx}}\n{extra}")
+    return path
+
+
+def _bump(station: Station) -> CompiledProgram:
+    moves = [
+        ir.JointMove(target=ir.JointTarget(joints=q), span=_span(k + 2)) for k, q in enumerate(BUMP)
+    ]
+    return _compile(station, *moves)
+
+
+def test_a_station_may_allow_a_pair_to_touch(tmp_path: Path) -> None:
+    plain = load_station(_station_file(tmp_path, ""))
+    assert _found(check_collisions(_bump(plain))) == [("self_collision", 1, 3)]
+    allowed = load_station(_station_file(tmp_path, "allowed_pairs: [[link_2, base]]\n"))
+    assert allowed.allowed_pairs == (("link_2", "base"),)
+    for clearance in (0.0, 0.01):
+        assert check_collisions(_bump(allowed), CollisionOptions(clearance_m=clearance)) == []
+
+
+@pytest.mark.parametrize(
+    ("extra", "line", "message"),
+    [
+        ("allowed_pairs: [[link_2, bsae]]\n", 3, "unknown body 'bsae' (known: base, link_1"),
+        ("allowed_pairs:\n  - [link_2]\n", 4, "expected two different names [A, B]"),
+        ("allowed_pairs:\n  - [link_2, link_2]\n", 4, "expected two different names [A, B]"),
+        ("allowed_pairs:\n  - [[link_2], base]\n", 4, "unknown body ['link_2']"),
+        ("allowed_pairs: link_2\n", 3, "expected a list"),
+    ],
+)
+def test_a_station_pair_must_name_two_bodies(
+    tmp_path: Path, extra: str, line: int, message: str
+) -> None:
+    from olp.errors import StationError
+
+    with pytest.raises(StationError) as caught:
+        load_station(_station_file(tmp_path, extra))
+    assert caught.value.span is not None and caught.value.span.line == line
+    assert message in caught.value.message
+
+
+def test_a_robot_file_pair_must_name_its_links(tmp_path: Path) -> None:
+    from olp.errors import StationError
+    from olp.station.loader import load_robot_model
+
+    text = (REPO / "stations" / "robots" / "kuka" / "kr6_r900_sixx.yaml").read_text()
+    robot = tmp_path / "my_kr6.yaml"
+    robot.write_text(text.replace("  - [link_4, link_6]", "  - [link_4, flange]"))
+    with pytest.raises(StationError) as caught:
+        load_robot_model(robot)
+    assert "unknown body 'flange'" in caught.value.message
+    assert caught.value.span is not None
+    assert robot.read_text().splitlines()[caught.value.span.line - 1] == "  - [link_4, flange]"
+
+
+def test_home_contacts_is_the_callers_choice_and_ignores_the_clearance(cell: Station) -> None:
+    """Without the library's declarations the KR 6's link_2 and link_4 capsules collide on every
+    move; allowing the pairs that overlap at home drops exactly those, and link_2 against the
+    base (21.6 mm apart at home) stays checked at any clearance."""
+    bare = dataclasses.replace(cell, robot=dataclasses.replace(cell.robot, allowed_pairs=()))
+    compiled = _bump(bare)
+    pairs = {pair for _, pair, _ in _hits(check_collisions(compiled))}
+    assert pairs == {("robot link_2", "robot link_4"), ("robot link_2", "robot base")}
+    for clearance in (0.0, 0.03, 0.1):
+        chosen = CollisionOptions(clearance_m=clearance, home_contacts=True)
+        hits = _hits(check_collisions(compiled, chosen))
+        assert {pair for _, pair, _ in hits} == {("robot link_2", "robot base")}
+        assert ("self_collision", ("robot link_2", "robot base"), 1) in hits
+
+
+# --------------------------------------------------------------------------------------------
+# Absurd but valid input: a diagnostic or a usage error, never a traceback or a silent pass
+
+
+@pytest.mark.parametrize(
+    "options",
+    [
+        {"clearance_m": -0.001},
+        {"clearance_m": float("nan")},
+        {"clearance_m": float("inf")},
+        {"tolerance_m": 0.0},
+        {"tolerance_m": -1e-4},
+        {"tolerance_m": float("nan")},
+        {"tolerance_m": float("inf")},
+        {"tolerance_m": 1e-9},
+        {"tolerance_m": 0.1},
+        {"mode": "fast"},
+    ],
+)
+def test_bad_collision_options_are_usage_errors(options: dict[str, object]) -> None:
+    from olp.errors import UsageError
+
+    with pytest.raises(UsageError, match=r"collision (clearance|tolerance|mode)"):
+        CollisionOptions(**options)  # type: ignore[arg-type]
+
+
+def test_an_infinite_clearance_on_the_command_line_is_a_usage_error(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from olp.cli import main
+
+    program = tmp_path / "bump.src"
+    program.write_text(BUMP_SRC)
+    station = str(REPO / "stations" / "kr6_milling_cell.yaml")
+    assert main(["check", station, str(program), "--clearance", "1e400"]) == 2
+    assert "clearance must be a finite distance" in capsys.readouterr().err
+
+
+def test_a_huge_clearance_reports_every_checked_pair_once(cell: Station) -> None:
+    from olp.passes.collide import check_collisions_with_stats
+
+    found, stats = check_collisions_with_stats(_bump(cell), CollisionOptions(clearance_m=1e6))
+    assert len(found) == stats.pairs > 10
+    assert all("(closer than 1000000000.0 mm)" in d.message for d in found)
+
+
+def test_zero_length_motions_are_checked_like_any_other(cell: Station) -> None:
+    home = cell.robot.home
+    assert check_collisions(_compile(cell, _ptp(home, 2), _ptp(home, 3), _ptp(home, 4))) == []
+    folded = np.radians([0, -10, 156, 0, 0, 0])  # the wrist on the base
+    found = check_collisions(_compile(cell, _ptp(folded, 2), _ptp(folded, 3), _ptp(folded, 4)))
+    assert {d.message.split(": ", 1)[0] for d in found} == {"moves 0-2"}
+
+
+@pytest.mark.parametrize(
+    ("pose", "shape"),
+    [
+        (transl(1e300, 0, 0), Shape("box", np.eye(4), (0.1, 0.1, 0.1))),
+        (transl(1e6, 0, 0), Shape("box", np.eye(4), (0.1, 0.1, 0.1))),
+        (transl(0, 0, -2.5e4), Shape("box", np.eye(4), (5e4, 5e4, 5e4))),
+        (transl(0, 0, -5e19), Shape("box", np.eye(4), (1e20, 1e20, 1e20))),
+        (transl(1e300, 0, 0), Shape("sphere", np.eye(4), (1e300,))),
+    ],
+)
+def test_a_body_beyond_exact_distances_is_an_error(
+    cell: Station, pose: np.ndarray, shape: Shape
+) -> None:
+    """Bodies beyond 1 km of the robot, where coal's distances lose their accuracy (a box of
+    50 km side 10 mm below a link is reported touching), cannot be checked: an error at the
+    first motion, not a pass (and no overflow warning either)."""
+    station = _with(cell, StationObject("far", "fixture", pose, (shape,)))
+    found = check_collisions(_compile(station, _ptp(SWEEP_FROM, 2), _ptp(SWEEP_TO, 3)))
+    assert _found(found) == [("collision_unchecked", 0, 2)]
+    assert found[0].severity == "error"
+    assert found[0].message.startswith("collisions with fixture 'far' cannot be checked")
+
+
+def test_a_distance_that_is_not_a_number_is_an_error(
+    cell: Station, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    compiled = _compile(cell, _ptp(SWEEP_FROM, 2), _ptp(SWEEP_TO, 3))
+    monkeypatch.setattr(Scene, "distance", lambda self, pair: float("nan"))
+    for mode in ("advance", "samples"):
+        found = check_collisions(compiled, CollisionOptions(mode=mode))  # type: ignore[arg-type]
+        assert found and {d.kind for d in found} == {"collision_unchecked"}
+        assert all(d.severity == "error" and "not a number" in d.message for d in found)
+
+
+class _Constant:
+    """A scene whose one pair is at the distances given, in turn (the last one repeats)."""
+
+    def __init__(self, *distances: float) -> None:
+        self.distances = list(distances)
+
+    def place(self, chain: np.ndarray) -> None:
+        pass
+
+    def distance(self, pair: object) -> float:
+        return self.distances.pop(0) if len(self.distances) > 1 else self.distances[0]
+
+
+def test_the_advancement_gives_up_instead_of_running_for_ever(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A pair that grazes contact along a path whose displacement bound is huge (1e20 m): each
+    step is half a tolerance, so proving the path would take 1e24 evaluations; and once the
+    bound is that large a step no longer moves the frontier at all."""
+    from olp.collision import advance as advance_module
+    from olp.collision.advance import Unresolved
+
+    run = path_run([np.array([[0.0], [1.0], [2.0]])], lambda q: q)
+    cum = np.array([0.0, 1e20, 2e20])
+    lower, upper = -1e-4, -5e-5
+    monkeypatch.setattr(advance_module, "MAX_EVALUATIONS", 1000)
+    with pytest.raises(Unresolved, match="no proof after 1000 distance evaluations"):
+        advance(_Constant(0.0), None, run, lower, upper, cum)  # type: ignore[arg-type]
+    with pytest.raises(Unresolved, match="below floating-point resolution") as caught:
+        advance(_Constant(1.5e20, 0.0), None, run, lower, upper, cum)  # type: ignore[arg-type]
+    assert caught.value.where.motion == 0 and 0.5 < caught.value.where.fraction < 1.0
