@@ -28,10 +28,9 @@ import pytest
 import olp
 from olp import ir
 from olp.diagnostics import Diagnostic
-from olp.frontends.csv import CsvOptions
 from olp.kinematics.base import turn_variants
 from olp.kinematics.configuration import satisfies
-from olp.passes.resolve import CompiledProgram, ResolveOptions, Step
+from olp.passes.resolve import CompiledProgram, Step
 from olp.posts import find_post
 from olp.posts.abb import PREDEFINED_NAMES, speed_name, speeddata, zone_name, zonedata
 from olp.posts.base import Post
@@ -458,48 +457,6 @@ def test_split_modules(tmp_path: Path) -> None:
     # the targets are numbered through the whole program: p1 .. p8 once each
     targets = re.findall(r"LOCAL CONST \w+ (p\d+) :=", "".join(files.values()))
     assert targets == [f"p{n}" for n in range(1, 9)]
-
-
-# --------------------------------------------------------------------------------------------
-# Golden files: USERS.md jobs 1-6 on the KUKA cell (transpiled to RAPID), the pick program on
-# the ABB cell, and job 5 split
-
-JOBS: dict[str, tuple[Path, str, dict[str, Any]]] = {
-    "job1_weld_polygon": (KUKA_CELL, "examples/weld_polygon.py", {}),
-    "job2_points_to_program": (KUKA_CELL, "examples/points_to_program.py", {}),
-    "job3_csv_xyz": (
-        KUKA_CELL,
-        "examples/path_xyz.csv",
-        {"csv_options": CsvOptions(frame="table", orientation=(180.0, 0.0, 180.0))},
-    ),
-    "job4_csv_xyzwpr": (
-        KUKA_CELL,
-        "examples/targets_xyzwpr.csv",
-        {
-            "csv_options": CsvOptions(frame="table"),
-            "options": ResolveOptions(skip_unreachable=True),
-        },
-    ),
-    "job5_milling": (KUKA_CELL, "examples/milling.src", {}),
-    "job6_feasibility_grid": (KUKA_CELL, "examples/feasibility_grid.py", {}),
-    "irb120_pick": (CELL, "tests/posts/pick_irb120.src", {}),
-}
-
-
-def _golden_files(job: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> dict[str, bytes]:
-    monkeypatch.chdir(REPO)  # relative sources: no machine's folders in the header comments
-    post = str(_split_post(tmp_path, 3).manifest.folder) if job == "job5_milling_split" else "abb"
-    cell, program, kwargs = JOBS["job5_milling" if job == "job5_milling_split" else job]
-    result = olp.build(olp.load_station(cell), program, post=post, **kwargs)
-    assert result.ok, [d.format() for d in result.diagnostics]
-    return {name: text.encode("ascii") for name, text in sorted(rapid(dict(result.files)).items())}
-
-
-@pytest.mark.parametrize("job", [*JOBS, "job5_milling_split"])
-def test_golden(
-    job: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, golden: GoldenCheck
-) -> None:
-    golden(GOLDEN / job, _golden_files(job, tmp_path, monkeypatch))
 
 
 # --------------------------------------------------------------------------------------------

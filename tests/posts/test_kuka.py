@@ -26,11 +26,10 @@ import olp
 from olp import ir
 from olp.diagnostics import Diagnostic
 from olp.errors import PostError
-from olp.frontends.csv import CsvOptions
 from olp.frontends.krl import load_krl
 from olp.kinematics.base import turn_variants
 from olp.kinematics.configuration import satisfies
-from olp.passes.resolve import CompiledProgram, ResolveOptions, Step
+from olp.passes.resolve import CompiledProgram, Step
 from olp.posts import find_post
 from olp.posts.base import Post
 from olp.posts.kuka import NAME_RULE, krl_e6pos, krl_percent, krl_point_type
@@ -587,50 +586,6 @@ def test_split_parts_are_called_in_order_and_read_back_whole(
         for m in _motions(load_krl(tmp_path / "out" / f"Milling_P{k}.src").program)
     ]
     _same_targets(_motions(original), motions)
-
-
-# --------------------------------------------------------------------------------------------
-# Golden files: USERS.md jobs 1-6 (and job 5 split)
-
-JOBS: dict[str, tuple[Path, str, dict[str, Any]]] = {
-    "job1_weld_polygon": (CELL, "examples/weld_polygon.py", {}),
-    "job2_points_to_program": (CELL, "examples/points_to_program.py", {}),
-    "job3_csv_xyz": (
-        CELL,
-        "examples/path_xyz.csv",
-        {"csv_options": CsvOptions(frame="table", orientation=(180.0, 0.0, 180.0))},
-    ),
-    "job4_csv_xyzwpr": (
-        CELL,
-        "examples/targets_xyzwpr.csv",
-        {
-            "csv_options": CsvOptions(frame="table"),
-            "options": ResolveOptions(skip_unreachable=True),
-        },
-    ),
-    "job5_milling": (CELL, "examples/milling.src", {}),
-    "job6_feasibility_grid": (CELL, "examples/feasibility_grid.py", {}),
-}
-
-
-def _golden_files(job: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> dict[str, bytes]:
-    monkeypatch.chdir(REPO)  # relative sources: no machine's folders in the header comments
-    if job == "job5_milling_split":
-        post: str = str(_split_post(tmp_path, 3).manifest.folder)
-        cell, program, kwargs = JOBS["job5_milling"]
-    else:
-        post = "kuka"
-        cell, program, kwargs = JOBS[job]
-    result = olp.build(olp.load_station(cell), program, post=post, **kwargs)
-    assert result.ok, [d.format() for d in result.diagnostics]
-    return {name: text.encode("ascii") for name, text in sorted(result.files.items())}
-
-
-@pytest.mark.parametrize("job", [*JOBS, "job5_milling_split"])
-def test_golden(
-    job: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, golden: GoldenCheck
-) -> None:
-    golden(GOLDEN / job, _golden_files(job, tmp_path, monkeypatch))
 
 
 # --------------------------------------------------------------------------------------------

@@ -486,22 +486,6 @@ def test_transpiled_krl_runs_the_planned_joint_path_on_the_ur5e() -> None:
 # Golden files and the post's place in the CLI
 
 
-GOLDEN_CASES = {
-    "Milling.script": (KUKA_CELL, REPO / "examples" / "milling.src"),
-    "Transpile.script": (UR_CELL, TRANSPILE),
-}
-
-
-@pytest.mark.parametrize("name", list(GOLDEN_CASES))
-def test_golden(name: str, tmp_path: Path, golden: GoldenCheck) -> None:
-    cell, source = GOLDEN_CASES[name]
-    result = _build(_station(cell), source, out_dir=tmp_path)
-    assert result.ok and list(result.files) == [name]
-    written = (tmp_path / name).read_bytes()
-    golden(GOLDEN, {name: written}, whole_folder=False)
-    assert b"\r" not in written and written.endswith(b"end\n") and written.isascii()
-
-
 def test_golden_diagnostics() -> None:
     milling = _build(_station(KUKA_CELL), REPO / "examples" / "milling.src")
     assert [d.kind for d in milling.diagnostics] == ["foreign_robot"]
