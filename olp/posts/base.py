@@ -105,6 +105,8 @@ class Post:
 
     NAME: ClassVar[str] = ""
     """The registry name (``olp build --post NAME``)."""
+    FOLDER: ClassVar[Path | None] = None
+    """The template folder of a registered post (None: the bundled ``posts/<NAME>/``)."""
     VENDOR: ClassVar[str] = ""
     """The robot brand whose controllers run this code ("" for a brand-neutral post)."""
     LANGUAGE: ClassVar[str] = "robot code"
