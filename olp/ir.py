@@ -20,12 +20,15 @@ Fields are keyword-only: ``LinearMove(target=..., speed=..., span=...)``.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal, TypeAlias, TypeGuard
+from typing import TYPE_CHECKING, Any, Literal, TypeAlias, TypeGuard
 
 import numpy as np
 from numpy.typing import NDArray
+
+if TYPE_CHECKING:
+    from typing import Self
 
 FloatArray: TypeAlias = NDArray[np.float64]
 
@@ -268,6 +271,42 @@ class _Motion:
     frame: Frame = field(default_factory=lambda: WORLD)
     span: SourceSpan = GENERATED
 
+    def with_speed(
+        self,
+        *,
+        linear: float | None = None,
+        joint: float | None = None,
+        angular: float | None = None,
+        joint_acceleration: float | None = None,
+    ) -> Self:
+        """A copy with the given speed parts changed (m/s, fractions, rad/s); the others kept.
+
+        ``move.with_speed(linear=min(move.speed.linear, 0.1))`` caps the TCP speed at 100 mm/s.
+        """
+        changes = {
+            name: value
+            for name, value in (
+                ("linear", linear),
+                ("joint", joint),
+                ("angular", angular),
+                ("joint_acceleration", joint_acceleration),
+            )
+            if value is not None
+        }
+        return dataclasses.replace(self, speed=dataclasses.replace(self.speed, **changes))
+
+    def with_zone(self, radius: float) -> Self:
+        """A copy that blends with ``radius`` metres (0: a fine stop)."""
+        return dataclasses.replace(self, zone=Zone(radius))
+
+    def with_tool(self, tool: Tool) -> Self:
+        """A copy that runs with ``tool`` (the target stays the TCP pose it was)."""
+        return dataclasses.replace(self, tool=tool)
+
+    def with_frame(self, frame: Frame) -> Self:
+        """A copy whose target is read in ``frame`` (the numbers of the target are kept)."""
+        return dataclasses.replace(self, frame=frame)
+
 
 @_array_eq
 @dataclass(frozen=True, slots=True, kw_only=True, eq=False)
@@ -379,6 +418,60 @@ class Program:
     def replace_instructions(self, instructions: Sequence[Instruction]) -> Program:
         """A copy with other instructions (for IR -> IR transforms)."""
         return dataclasses.replace(self, instructions=tuple(instructions))
+
+    # ----------------------------------------------------------------------------------------
+    # Editing as data (USERS.md job 12): each returns a new program; the source spans stay.
+
+    def map(self, edit: Callable[[Instruction], Edit]) -> Program:
+        """A copy where every instruction is replaced by ``edit(instruction)``: an instruction,
+        a sequence of them (inserted in its place), or None (deleted)."""
+        out: list[Instruction] = []
+        for instruction in self.instructions:
+            out.extend(_as_list(edit(instruction)))
+        return self.replace_instructions(out)
+
+    def map_motions(self, edit: Callable[[Motion], Edit]) -> Program:
+        """:meth:`map` on the motions only; other instructions are kept as they are::
+
+        program.map_motions(lambda m: m.with_speed(linear=min(m.speed.linear, 0.1)))
+        """
+        return self.map(lambda i: edit(i) if is_motion(i) else i)
+
+    def filter(self, keep: Callable[[Instruction], bool]) -> Program:
+        """A copy with only the instructions ``keep`` accepts::
+
+        program.filter(lambda i: i.kind != "wait")
+        """
+        return self.map(lambda i: i if keep(i) else None)
+
+    def insert_after(
+        self, match: Callable[[Instruction], bool], make: Callable[[Instruction], Edit]
+    ) -> Program:
+        """A copy with ``make(instruction)`` inserted after every instruction ``match``
+        accepts::
+
+            program.insert_after(lambda i: i.kind == "call", lambda i: Call(name="LogStep"))
+        """
+        return self.map(lambda i: [i, *_as_list(make(i))] if match(i) else i)
+
+    def insert_before(
+        self, match: Callable[[Instruction], bool], make: Callable[[Instruction], Edit]
+    ) -> Program:
+        """A copy with ``make(instruction)`` inserted before every instruction ``match``
+        accepts."""
+        return self.map(lambda i: [*_as_list(make(i)), i] if match(i) else i)
+
+
+Edit: TypeAlias = "Instruction | Sequence[Instruction] | None"
+"""What an edit returns for one instruction: its replacement, several, or None (delete it)."""
+
+
+def _as_list(edit: Instruction | Sequence[Instruction] | None) -> list[Instruction]:
+    if edit is None:
+        return []
+    if isinstance(edit, Sequence):
+        return list(edit)
+    return [edit]
 
 
 def is_motion(instruction: Instruction) -> TypeGuard[Motion]:

@@ -258,3 +258,30 @@ def test_bad_options_exit_2_with_a_message(
 def test_orientation_with_a_leading_minus(tmp_path: Path) -> None:
     args = ["--frame", "table", "--orientation=-180,0,-180", "-o", str(tmp_path / "out"), "-q"]
     assert main(["build", str(CELL), str(EXAMPLES / "path_xyz.csv"), *args]) == 0
+
+
+# ------------------------------------------------------------------------------------------------
+# Job 12: edit a program as data
+
+
+def test_job12_edit_program(station: Station) -> None:
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("edit_program", EXAMPLES / "edit_program.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    original = olp.parse(EXAMPLES / "pick_and_place.py", station=station).program
+    edited = module.edit(original)
+    assert any(m.speed.linear > 0.1 for m in original.motions())
+    assert all(m.speed.linear <= 0.1 for m in edited.motions())
+    assert not any(isinstance(i, ir.Wait) for i in edited)
+    calls = [k for k, i in enumerate(edited.instructions) if isinstance(i, ir.Call)]
+    pairs = list(zip(calls[::2], calls[1::2], strict=True))
+    assert pairs and all(
+        edited.instructions[b].name == "LogStep" and b == a + 1  # type: ignore[union-attr]
+        for a, b in pairs
+    )
+    result = olp.build(station, edited, post="kuka")
+    (src,) = [text for name, text in result.files.items() if name.endswith(".src")]
+    assert result.ok and src.count("LogStep()") == len(pairs)

@@ -87,3 +87,67 @@ def test_tool_reference_without_pose_is_allowed() -> None:
     assert tool.pose is None
     frame = ir.Frame(name="table", pose=rotz(0.1))
     assert frame.pose is not None
+
+
+# --------------------------------------------------------------------------------------------
+# Editing as data (USERS.md job 12)
+
+
+def _edit_program() -> ir.Program:
+    span = ir.SourceSpan("p.src", 3)
+    lin = ir.LinearMove(
+        target=ir.CartesianTarget(pose=np.eye(4)), speed=ir.Speed(linear=0.5), span=span
+    )
+    return ir.Program(
+        name="p",
+        instructions=(
+            lin,
+            ir.Wait(seconds=1.0),
+            ir.Call(name="Grip"),
+            lin.with_speed(linear=0.05),
+            ir.Comment(text="end"),
+        ),
+    )
+
+
+def test_with_speed_changes_only_the_parts_given() -> None:
+    move = _edit_program().instructions[0]
+    assert isinstance(move, ir.LinearMove)
+    slower = move.with_speed(linear=0.1, joint=0.5)
+    assert (slower.speed.linear, slower.speed.joint) == (0.1, 0.5)
+    assert slower.speed.angular == move.speed.angular and slower.span == move.span
+    assert move.speed.linear == 0.5  # the original is unchanged
+    with pytest.raises(ir.IRError):
+        move.with_speed(linear=-1.0)
+    zoned = move.with_zone(0.01).with_tool(ir.Tool(name="t")).with_frame(ir.Frame(name="f"))
+    assert (zoned.zone.radius, zoned.tool.name, zoned.frame.name) == (0.01, "t", "f")
+
+
+def test_map_motions_filter_and_insert_after() -> None:
+    program = _edit_program()
+    capped = program.map_motions(lambda m: m.with_speed(linear=min(m.speed.linear, 0.1)))
+    assert [m.speed.linear for m in capped.motions()] == [0.1, 0.05]
+    assert [i.kind for i in capped] == [i.kind for i in program]
+    no_waits = capped.filter(lambda i: i.kind != "wait")
+    assert [i.kind for i in no_waits] == ["linear", "call", "linear", "comment"]
+    logged = no_waits.insert_after(
+        lambda i: isinstance(i, ir.Call), lambda i: ir.Call(name="LogStep", args=(f'"{i.name}"',))
+    )
+    assert [getattr(i, "name", i.kind) for i in logged] == [
+        "linear",
+        "Grip",
+        "LogStep",
+        "linear",
+        "comment",
+    ]
+    before = logged.insert_before(lambda i: i.kind == "comment", lambda i: [ir.Wait(seconds=0.1)])
+    assert [i.kind for i in before][-2:] == ["wait", "comment"]
+    assert program.instructions[0].span == logged.instructions[0].span
+
+
+def test_map_deletes_and_expands() -> None:
+    program = _edit_program()
+    edited = program.map(
+        lambda i: None if i.kind == "comment" else [i, i] if i.kind == "wait" else i
+    )
+    assert [i.kind for i in edited] == ["linear", "wait", "wait", "call", "linear"]
