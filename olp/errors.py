@@ -7,7 +7,7 @@ or was used wrongly; the CLI turns it into exit code 2 and a located message.
 
 from __future__ import annotations
 
-from olp.ir import SourceSpan
+from olp.span import SourceSpan
 
 
 class OlpError(Exception):

@@ -27,6 +27,8 @@ from typing import TYPE_CHECKING, Any, Literal, TypeAlias, TypeGuard
 import numpy as np
 from numpy.typing import NDArray
 
+from olp.span import GENERATED, SourceSpan
+
 if TYPE_CHECKING:
     from typing import Self
 
@@ -67,29 +69,6 @@ def _array_eq(cls: type) -> type:
     cls.__eq__ = _fields_equal  # type: ignore[assignment]
     cls.__hash__ = None  # type: ignore[assignment]
     return cls
-
-
-@dataclass(frozen=True, slots=True)
-class SourceSpan:
-    """Where something came from: 1-based line and column (end exclusive, optional)."""
-
-    file: str
-    line: int
-    column: int = 1
-    end_line: int | None = None
-    end_column: int | None = None
-
-    def __str__(self) -> str:
-        return f"{self.file}:{self.line}:{self.column}"
-
-    @property
-    def location(self) -> str:
-        """``file:line``, the form used in reports."""
-        return f"{self.file}:{self.line}"
-
-
-GENERATED = SourceSpan("<generated>", 0, 0)
-"""Span for instructions made by a transform rather than read from a file."""
 
 
 # --------------------------------------------------------------------------------------------

@@ -32,7 +32,7 @@ from pathlib import Path
 from typing import Any
 
 from olp.errors import PostError
-from olp.transforms.split import LIMIT_KEYS, SplitLimits
+from olp.transforms.limits import LIMIT_KEYS, SplitLimits
 
 FRAMES_IN = ("world", "robot_base")
 """What frame poses are written relative to: the station's world (the controller's world frame

@@ -13,12 +13,15 @@ A transform never knows a brand: name rules come in as a function (a vendor's ``
 
 from __future__ import annotations
 
-from olp.transforms.split import (
-    SplitLimits,
-    part_names,
-    split_bounds,
-    split_program,
-    split_steps,
-)
+from typing import Any
 
 __all__ = ["SplitLimits", "part_names", "split_bounds", "split_program", "split_steps"]
+
+
+def __getattr__(name: str) -> Any:
+    """The splitting names, imported on first use (``olp posts`` reads limits without numpy)."""
+    if name in __all__:
+        from olp.transforms import split
+
+        return getattr(split, name)
+    raise AttributeError(f"module 'olp.transforms' has no attribute {name!r}")
