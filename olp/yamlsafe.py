@@ -175,8 +175,11 @@ class YamlDocument:
         return shorten(" ".join(self.text[start:end].split()), limit)
 
     def shown(self, path: KeyPath) -> str:
-        """The value at ``path`` as an error message quotes it: ``'text'``, or ``nothing``."""
+        """The value at ``path`` as an error message quotes it: ``'text'`` (or ``"text"`` as
+        written, when the user quoted it), or ``nothing``."""
         text = self.source(path)
+        if len(text) >= 2 and text[0] in "'\"" and text[-1] == text[0]:
+            return text
         return f"'{text}'" if text else "nothing"
 
     def error(self, path: KeyPath, message: str) -> OlpError:

@@ -57,6 +57,7 @@ def test_where_each_value_was_written() -> None:
     assert doc.locations[("a", "b", 1)] == (2, 10)
     assert doc.shown(("a", "b", 1)) == "'2024-01-01'"
     assert doc.shown(("a", "c")) == "'{x: 1}'"
+    assert parse_yaml('a: "x y"', "f", StationError).shown(("a",)) == '"x y"'  # as written
     error = doc.error(("a", "c", "x"), "wrong")
     assert error.message == "a.c.x: wrong" and error.source_line == "  c: {x: 1}"
 
