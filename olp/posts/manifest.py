@@ -59,13 +59,10 @@ class PostManifest:
 
 def load_manifest(folder: Path) -> PostManifest:
     """Read and check ``folder/post.yaml``."""
-    import yaml
+    from olp.yamlsafe import read_yaml
 
     path = folder / "post.yaml"
-    try:
-        raw = yaml.safe_load(path.read_text(encoding="utf-8"))
-    except (OSError, yaml.YAMLError) as exc:
-        raise PostError(f"cannot read post manifest {path}: {exc}") from exc
+    raw = read_yaml(path, PostError).value
     if not isinstance(raw, dict) or not isinstance(raw.get("files"), list):
         raise PostError(f"{path}: expected a mapping with a 'files' list")
     limits = _limits(raw.get("limits"), path)

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, Literal, TypeVar
 
 import numpy as np
@@ -63,6 +64,29 @@ class JointLimits:
 
 
 @dataclass(frozen=True, slots=True, eq=False)
+class MeshHull:
+    """The convex hull of a mesh in its shape's frame: ``vertices`` (V, 3) m and outward
+    triangles ``faces`` (F, 3), indices into ``vertices``. Read-only arrays."""
+
+    vertices: FloatArray
+    faces: NDArray[np.int64]
+
+    def __post_init__(self) -> None:
+        vertices = np.array(self.vertices, dtype=np.float64)
+        faces = np.array(self.faces, dtype=np.int64)
+        if vertices.ndim != 2 or vertices.shape[1] != 3:
+            raise ValueError(f"MeshHull: vertices must be (V, 3), got {vertices.shape}")
+        if faces.ndim != 2 or faces.shape[1] != 3:
+            raise ValueError(f"MeshHull: faces must be (F, 3), got {faces.shape}")
+        if faces.size and (faces.min() < 0 or faces.max() >= len(vertices)):
+            raise ValueError("MeshHull: faces must index into vertices")
+        vertices.setflags(write=False)
+        faces.setflags(write=False)
+        object.__setattr__(self, "vertices", vertices)
+        object.__setattr__(self, "faces", faces)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
 class Shape:
     """A body's geometry: a primitive or a mesh, placed by ``pose`` (4, 4) in its parent frame.
 
@@ -70,7 +94,9 @@ class Shape:
     ``cylinder`` (radius, length) and ``capsule`` (radius, length of its core segment), both
     along the pose's Z axis and centred on it; ``sphere`` (radius,); ``mesh``: the file ``mesh``
     scaled by ``scale`` (file units to metres). ``link``: for a robot's collision model, the
-    link frame the shape moves with (``"base"`` or a link of the kinematic chain).
+    link frame the shape moves with (``"base"`` or a link of the kinematic chain). ``hull``:
+    a mesh's convex hull as the station loader read and checked it (None when the shape was
+    made in code; then the file is read when needed).
     """
 
     kind: ShapeKind
@@ -79,6 +105,7 @@ class Shape:
     mesh: str | None = None
     scale: float = 1.0
     link: str = ""
+    hull: MeshHull | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "pose", _frozen(self.pose, (4, 4)))
@@ -87,6 +114,8 @@ class Shape:
             raise ValueError(f"{self.kind}: expected {expected} positive sizes, got {self.size}")
         if (self.kind == "mesh") != (self.mesh is not None):
             raise ValueError("a mesh shape (and only a mesh shape) names a mesh file")
+        if self.hull is not None and self.kind != "mesh":
+            raise ValueError(f"a {self.kind} has no mesh hull")
 
     def contains(self, points: ArrayLike, frame: ArrayLike | None = None) -> NDArray[np.bool_]:
         """Which points (..., 3), metres in ``frame``'s coordinates (default: the parent frame,
@@ -111,12 +140,13 @@ class Shape:
         raise ValueError("Shape.contains: meshes are not primitives; load the mesh")
 
     def load_mesh(self) -> Any:
-        """The mesh as a ``trimesh.Trimesh`` in metres (in the shape's own frame)."""
+        """The mesh as a ``trimesh.Trimesh`` in metres (in the shape's own frame), read under
+        the rules of :func:`olp.station.meshes.read_mesh` (a ``MeshError`` if it breaks one)."""
         if self.mesh is None:
             raise ValueError(f"a {self.kind} has no mesh file")
-        import trimesh
+        from olp.station.meshes import read_mesh
 
-        mesh = trimesh.load(self.mesh, force="mesh")
+        mesh = read_mesh(Path(self.mesh))
         mesh.apply_scale(self.scale)
         return mesh
 

@@ -63,7 +63,11 @@ _PRIMITIVES: dict[str, Any] = {
     ),
     "mesh": _object(
         {
-            "file": {"type": "string", "description": "STL/OBJ/PLY/GLB, relative to this file"},
+            "file": {
+                "type": "string",
+                "description": "STL/OBJ/PLY/GLB (at most 64 MiB), relative to this file and "
+                "inside its folder (see allow_outside_paths); not flat: its convex hull collides",
+            },
             "units": {"enum": ["mm", "m"], "description": "units of the file (default mm)"},
         },
         ("file",),
@@ -125,7 +129,10 @@ _KINEMATICS = _object(
                 ("a", "alpha_deg", "d"),
             ),
         },
-        "file": {"type": "string", "description": "URDF: file, relative to this file"},
+        "file": {
+            "type": "string",
+            "description": "URDF: file, relative to this file and inside its folder",
+        },
         "tip": {"type": "string", "description": "URDF: the flange link (tool0)"},
         "base": {"type": "string", "description": "URDF: the base link (default: the root)"},
         "coupling": _COUPLING,
@@ -169,7 +176,10 @@ ROBOT_MODEL = _object(
 
 _STATION_ROBOT = _object(
     {
-        "model": {"type": "string", "description": "library name (vendor/model) or a .yaml file"},
+        "model": {
+            "type": "string",
+            "description": "library name (vendor/model) or a .yaml file inside this file's folder",
+        },
         "base": _ref("pose"),
         **_MODEL_PROPS,
     },
@@ -233,6 +243,14 @@ STATION: dict[str, Any] = {
         {
             "name": {"type": "string"},
             "description": {"type": "string"},
+            "allow_outside_paths": {
+                "type": "boolean",
+                "default": False,
+                "description": "true: files this station names (meshes, a robot file, a URDF) "
+                "may lie outside its folder (absolute paths, '..', symbolic links out of it). "
+                "Default false: such a file is an error. /proc, /sys, /dev, devices and FIFOs "
+                "are never read either way.",
+            },
             "robot": _STATION_ROBOT,
             "tools": {"type": "array", "items": _ref("tool")},
             "frames": {"type": "array", "items": _ref("frame")},

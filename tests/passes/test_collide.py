@@ -754,7 +754,7 @@ def test_a_station_may_allow_a_pair_to_touch(tmp_path: Path) -> None:
         ("allowed_pairs: [[link_2, bsae]]\n", 3, "unknown body 'bsae' (known: base, link_1"),
         ("allowed_pairs:\n  - [link_2]\n", 4, "expected two different names [A, B]"),
         ("allowed_pairs:\n  - [link_2, link_2]\n", 4, "expected two different names [A, B]"),
-        ("allowed_pairs:\n  - [[link_2], base]\n", 4, "unknown body ['link_2']"),
+        ("allowed_pairs:\n  - [[link_2], base]\n", 4, "unknown body '[link_2]'"),
         ("allowed_pairs: link_2\n", 3, "expected a list"),
     ],
 )

@@ -81,7 +81,7 @@ def test_sample_cells_for_each_brand_exist() -> None:
             "name: x\nrobot:\n  model: kuka/kr6_r900_sixx\n"
             "tools:\n  - {name: t, tcp: {xyz: [1, 2, a]}}\n",
             5,
-            "finite number",
+            "expected a number (a length in mm), got text 'a'",
         ),
         ("name: x\nrobot: [1, 2\n", 3, "invalid YAML"),
         ("name: x\n", 1, "missing required key 'robot'"),
