@@ -13,13 +13,15 @@ What is checked (coal through pinocchio's ``GeometryModel``; meshes as convex hu
 * by default the tool may touch and enter *parts* (machining, welding, screwing); it is checked
   against fixtures.
 
-The set of checked pairs does not depend on the clearance: a larger ``clearance_m`` only adds
-margin, so a program that fails at one clearance fails at every larger one.
+Two clearances: ``clearance_m`` between the robot side (links, tool, carried parts) and the
+station (parts, fixtures), ``self_clearance_m`` between the robot's own bodies (link-link,
+link-tool, link-carried part). The set of checked pairs depends on neither: a larger clearance
+only adds margin, so a program that fails at one pair of clearances fails at every larger one.
 
 Along every motion the piecewise-linear joint path between the resolve pass's samples is proven
 free by conservative advancement (:mod:`olp.collision.advance`): if nothing is reported, every
-checked pair keeps a signed distance above ``clearance_m - tolerance_m`` everywhere on that path,
-a thin wall between two samples included. For a joint move that path is the motion itself
+checked pair keeps a signed distance above its clearance minus ``tolerance_m`` everywhere on that
+path, a thin wall between two samples included. For a joint move that path is the motion itself
 (straight in joint space). For a linear move the real TCP line is sampled every ``step_m`` /
 ``step_rad`` and joined by joint-space chords; between samples the chord deviates from the
 exact path by a second-order amount: :func:`olp.collision.chord.chord_deviation` estimates it
@@ -76,11 +78,13 @@ class Attachment:
 class CollisionOptions:
     """Settings of the collision check.
 
-    ``clearance_m``: bodies closer than this (m) collide (0: only overlap counts); it adds margin
-    to every checked pair and never changes which pairs are checked. ``tolerance_m``: the
-    resolution (within :data:`TOLERANCE_RANGE_M`): a pair closer than ``clearance_m -
-    tolerance_m`` anywhere on a motion is always reported; one that stays above ``clearance_m -
-    tolerance_m / 2`` never is (so parts resting on fixtures do not collide).
+    ``clearance_m``: the robot's links, tool and carried parts closer than this (m) to a part or
+    fixture collide (0: only overlap counts). ``self_clearance_m``: the same between the robot's
+    own bodies (link-link, link-tool, link-carried part). Each adds margin to every pair of its
+    kind and never changes which pairs are checked. ``tolerance_m``: the resolution (within
+    :data:`TOLERANCE_RANGE_M`): a pair closer than its clearance minus ``tolerance_m`` anywhere
+    on a motion is always reported; one that stays above its clearance minus ``tolerance_m / 2``
+    never is (so parts resting on fixtures do not collide).
 
     ``allowed_pairs``: pairs of body names never checked, added to the station's (robot links by
     link name, e.g. ``"link_3"``; the tool by its station name; parts and fixtures by name).
@@ -96,6 +100,7 @@ class CollisionOptions:
     """
 
     clearance_m: float = 0.0
+    self_clearance_m: float = 0.0
     tolerance_m: float = 1e-4
     allowed_pairs: tuple[tuple[str, str], ...] = ()
     self_collision: bool = True
@@ -105,10 +110,12 @@ class CollisionOptions:
     mode: Literal["advance", "samples"] = "advance"
 
     def __post_init__(self) -> None:
-        if not (math.isfinite(self.clearance_m) and self.clearance_m >= 0):
-            raise UsageError(
-                f"the collision clearance must be a finite distance >= 0, got {self.clearance_m}"
-            )
+        for what, value in (("", self.clearance_m), ("self-", self.self_clearance_m)):
+            if not (math.isfinite(value) and value >= 0):
+                raise UsageError(
+                    f"the collision {what}clearance must be a finite distance >= 0, "
+                    f"got {value * 1000:g} mm"
+                )
         low, high = TOLERANCE_RANGE_M
         if not low <= self.tolerance_m <= high:
             raise UsageError(
@@ -169,7 +176,7 @@ def check_collisions_with_stats(
             stats.rows + run_stats.rows,
             max(stats.pairs, run_stats.pairs),
         )
-    checked = _diagnostics(found, opts.clearance_m)
+    checked = _diagnostics(found, opts)
     return _bodiless_tools(compiled) + setup + unresolved + checked, stats
 
 
@@ -245,6 +252,11 @@ def _too_far(label: str, radius: float, step: Step) -> Diagnostic:
     hint = "check the station's units and poses for this body"
     span = step.instruction.span
     return Diagnostic("error", "collision_unchecked", message, span, step.index, hint=hint)
+
+
+def _clearance(kind: str, opts: CollisionOptions) -> float:
+    """The clearance (m) for a pair of ``kind``: robot-internal or against the station."""
+    return opts.self_clearance_m if kind == "self_collision" else opts.clearance_m
 
 
 def _unknown_parts(compiled: CompiledProgram, opts: CollisionOptions) -> list[Diagnostic]:
@@ -382,8 +394,6 @@ def _check_run(
 
     scene = run.scene
     path = path_run([s.path for s in run.steps if s.path is not None], scene.chain_joints)
-    lower = opts.clearance_m - opts.tolerance_m
-    upper = opts.clearance_m - opts.tolerance_m / 2
     found: list[_Found] = []
     failed: list[Diagnostic] = []
     evaluations = 0
@@ -394,6 +404,8 @@ def _check_run(
     bounds = cumulative_bounds(path, unique) if opts.mode == "advance" else unique[:, :0]
     for k, pair in enumerate(scene.pairs):
         first, second = scene.name_of(pair)
+        clearance = _clearance(pair.kind, opts)
+        lower, upper = clearance - opts.tolerance_m, clearance - opts.tolerance_m / 2
         try:
             if opts.mode == "samples":
                 hits, count = sample_hits(scene, pair, path, upper)
@@ -430,7 +442,7 @@ def _unresolved(run: _Run, first: str, second: str, exc: Unresolved) -> Diagnost
 # Diagnostics
 
 
-def _diagnostics(found: Sequence[_Found], clearance: float) -> list[Diagnostic]:
+def _diagnostics(found: Sequence[_Found], opts: CollisionOptions) -> list[Diagnostic]:
     """One diagnostic per pair of bodies and run of consecutive colliding motions."""
     groups: dict[tuple[str, str, str], list[_Found]] = {}
     for f in sorted(found, key=lambda f: (f.first, f.second, f.ordinal)):
@@ -440,7 +452,7 @@ def _diagnostics(found: Sequence[_Found], clearance: float) -> list[Diagnostic]:
         start = 0
         for k in range(1, len(items) + 1):
             if k == len(items) or items[k].ordinal != items[k - 1].ordinal + 1:
-                out.append(_diagnostic(items[start:k], clearance))
+                out.append(_diagnostic(items[start:k], _clearance(items[0].kind, opts)))
                 start = k
     return sorted(out, key=lambda d: (d.index if d.index is not None else -1, d.message))
 

@@ -321,9 +321,11 @@ def test_the_milling_helix_is_free() -> None:
         for d in clamps
     )
     assert sum("clamp" in d.message for d in clamps) >= 4 * 3
-    # The margin holds for the robot's own links too: link_2 passes 21.6 mm from the base
+    # The robot's own links have their own margin: link_2 passes 21.6 mm from the base
     # capsule at home and stays that close all the way round.
-    assert [d.message for d in near if d.kind != "collision"] == [
+    assert [d.kind for d in near] == ["collision"] * len(near)
+    own = check_collisions(compiled, CollisionOptions(self_clearance_m=0.03))
+    assert [d.message for d in own] == [
         "moves 0-400: self-collision: robot link_2 hits robot base (closer than 30.0 mm) "
         "(first at 0% of move 0)"
     ]
@@ -480,17 +482,24 @@ PTP {A1 0,A2 -90,A3 90,A4 0,A5 30,A6 0}
 PTP {A1 0,A2 45,A3 -120,A4 0,A5 -120,A6 0}
 END
 """
-SWEEP_CLEARANCES = (0.0, 1e-3, 0.01, 0.0216, 0.05, 0.1, 1.0, 1e6)
+# Both clearances (m) swept over; 21.6 mm is link_2's distance from the base capsule at home.
+SWEEP_CLEARANCES = (0.0, 1e-3, 0.0216, 0.1, 1e6)
 
 
-def test_a_larger_clearance_fails_the_issue_program_too(tmp_path: Path) -> None:
+def test_a_larger_clearance_fails_the_issue_program_too(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """link_2 runs into the base: a self collision at every clearance and self-clearance,
+    including a large --clearance with the self-clearance left at 0."""
     from olp.cli import main
 
     program = tmp_path / "bump.src"
     program.write_text(BUMP_SRC)
     station = str(REPO / "stations" / "kr6_milling_cell.yaml")
-    for clearance in ("0", "100"):
-        assert main(["check", station, str(program), "-q", "--clearance", clearance]) == 1
+    for clearance, own in itertools.product(("0", "20", "100"), ("0", "10", "100")):
+        options = ["--clearance", clearance, "--self-clearance", own]
+        assert main(["check", station, str(program), "-q", *options]) == 1
+        assert "self-collision: robot link_2 hits robot base" in capsys.readouterr().err
 
 
 def _hits(diagnostics: list[Diagnostic]) -> set[tuple[str, tuple[str, str], int]]:
@@ -505,41 +514,25 @@ def _hits(diagnostics: list[Diagnostic]) -> set[tuple[str, tuple[str, str], int]
     return out
 
 
+Built = list[tuple[str, tuple[str, str], tuple[int, ...] | float]]
+
+
 def _checked_pairs(
     monkeypatch: pytest.MonkeyPatch, compiled: CompiledProgram, options: CollisionOptions
-) -> tuple[list[Diagnostic], list[tuple[tuple[str, str], tuple[int, ...]]]]:
-    """The diagnostics and every pair (names, geometry pairs) of every scene the pass built."""
+) -> tuple[list[Diagnostic], Built]:
+    """The diagnostics and every pair of every scene the pass built: ("checked", names,
+    geometry pairs)."""
     from olp.collision import scene as scene_module
 
-    built: list[tuple[tuple[str, str], tuple[int, ...]]] = []
+    built: Built = []
 
     def recording(*args: object, **kwargs: object) -> Scene:
         scene = build_scene(*args, **kwargs)  # type: ignore[arg-type]
-        built.extend((scene.name_of(p), p.geometry_pairs) for p in scene.pairs)
+        built.extend(("checked", scene.name_of(p), p.geometry_pairs) for p in scene.pairs)
         return scene
 
     monkeypatch.setattr(scene_module, "build_scene", recording)
     return check_collisions(compiled, options), built
-
-
-def test_the_checked_pairs_do_not_depend_on_the_clearance(
-    cell: Station, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    """The same pairs at every clearance, and what a clearance reports it reports at every
-    larger one (from half a tolerance up, the advancement's guarantee: below that a near miss
-    inside the tolerance band may go either way)."""
-    compiled = _compile(cell, _ptp(BUMP[0], 2), _ptp(BUMP[1], 3))
-    results = [
-        _checked_pairs(monkeypatch, compiled, CollisionOptions(clearance_m=c))
-        for c in SWEEP_CLEARANCES
-    ]
-    assert ("self_collision", ("robot link_2", "robot base"), 1) in _hits(results[0][0])
-    for (found, pairs), (more, more_pairs) in itertools.pairwise(results):
-        assert more_pairs == pairs == results[0][1]
-        assert _hits(found) <= _hits(more)
-    # At 1000 km every checked pair is too close: each is reported, and no other.
-    reported = {pair for _, pair, _ in _hits(results[-1][0])}
-    assert reported == {names for names, _ in results[0][1]}
 
 
 @pytest.fixture(scope="module")
@@ -547,19 +540,62 @@ def collision_cell() -> Station:
     return load_station(REPO / "stations" / "kr6_milling_collision_cell.yaml")
 
 
+def _spindle_moves(station: Station, *targets: np.ndarray) -> CompiledProgram:
+    tool = station.tools["spindle"]
+    moves = [
+        ir.JointMove(target=ir.JointTarget(joints=q), tool=tool, span=_span(k + 2))
+        for k, q in enumerate(targets)
+    ]
+    return resolve(ir.Program(name="t", instructions=tuple(moves)), station)
+
+
+def test_the_checked_pairs_do_not_depend_on_the_clearances(
+    collision_cell: Station, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The issue's program with the spindle among the clamps, over a grid of clearances and
+    self-clearances: the same pairs at every point, and what one point reports every point
+    with both clearances at least as large reports too (from half a tolerance up, the
+    advancement's guarantee: below that a near miss inside the tolerance band may go either
+    way). Each clearance governs its own kind."""
+    compiled = _spindle_moves(collision_cell, *BUMP)
+    grid = list(itertools.product(SWEEP_CLEARANCES, repeat=2))
+    results = {
+        (c, s): _checked_pairs(
+            monkeypatch, compiled, CollisionOptions(clearance_m=c, self_clearance_m=s)
+        )
+        for c, s in grid
+    }
+    base, _ = results[(0.0, 0.0)]
+    assert ("self_collision", ("robot link_2", "robot base"), 1) in _hits(base)
+    for a, b in itertools.product(grid, repeat=2):
+        if a[0] <= b[0] and a[1] <= b[1]:
+            (found, pairs), (more, more_pairs) = results[a], results[b]
+            assert more_pairs == pairs
+            assert _hits(found) <= _hits(more), (a, b)
+    for c, s in grid:
+        changed = {kind for kind, _, _ in _hits(results[(c, s)][0]) ^ _hits(base)}
+        if s == 0:
+            assert changed <= {"collision"}, c  # the clearance alone leaves the self pairs be
+        if c == 0:
+            assert changed <= {"self_collision"}, s
+    # At 1000 km every checked pair is too close: each is reported, and no other.
+    found, pairs = results[(1e6, 1e6)]
+    assert {pair for _, pair, _ in _hits(found)} == {n for what, n, _ in pairs if what == "checked"}
+
+
 def test_a_clearance_only_adds_margin_on_random_moves(
     collision_cell: Station, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """Property: random joint moves of the spindle robot, two clearances c and c + gap (gap at
-    least half the tolerance): the same pairs are checked and every hit at c is a hit at
-    c + gap."""
+    """Property: random joint moves of the spindle robot, two settings of (clearance,
+    self-clearance), the second larger in either or both (by at least half the tolerance): the
+    same pairs are checked and every hit of the first is one of the second."""
     from hypothesis import HealthCheck, given, settings
     from hypothesis import strategies as st
 
     robot = collision_cell.robot
-    tool = collision_cell.tools["spindle"]
     tolerance = CollisionOptions().tolerance_m
     unit = st.floats(0.0, 1.0)
+    grow = st.one_of(st.none(), st.floats(0, 0.1))
 
     @settings(
         max_examples=20,
@@ -567,17 +603,24 @@ def test_a_clearance_only_adds_margin_on_random_moves(
         derandomize=True,
         suppress_health_check=[HealthCheck.function_scoped_fixture],
     )
-    @given(st.lists(unit, min_size=12, max_size=12), st.floats(0, 0.15), st.floats(0, 0.1))
-    def check(fractions: list[float], clearance: float, gap: float) -> None:
+    @given(
+        st.lists(unit, min_size=12, max_size=12),
+        st.tuples(st.floats(0, 0.15), st.floats(0, 0.15)),
+        st.tuples(grow, grow),
+    )
+    def check(
+        fractions: list[float],
+        clearances: tuple[float, float],
+        gaps: tuple[float | None, float | None],
+    ) -> None:
         low, high = robot.limits.lower * 0.9, robot.limits.upper * 0.9
         targets = low + np.reshape(fractions, (2, 6)) * (high - low)
-        moves = [
-            ir.JointMove(target=ir.JointTarget(joints=q), tool=tool, span=_span(k + 2))
-            for k, q in enumerate(targets)
+        compiled = _spindle_moves(collision_cell, *targets)
+        larger = [
+            c if g is None else c + tolerance / 2 + g for c, g in zip(clearances, gaps, strict=True)
         ]
-        compiled = resolve(ir.Program(name="t", instructions=tuple(moves)), collision_cell)
-        lower = CollisionOptions(clearance_m=clearance)
-        upper = CollisionOptions(clearance_m=clearance + tolerance / 2 + gap)
+        lower = CollisionOptions(clearance_m=clearances[0], self_clearance_m=clearances[1])
+        upper = CollisionOptions(clearance_m=larger[0], self_clearance_m=larger[1])
         found, pairs = _checked_pairs(monkeypatch, compiled, lower)
         more, more_pairs = _checked_pairs(monkeypatch, compiled, upper)
         assert pairs == more_pairs
@@ -745,7 +788,8 @@ def test_a_station_may_allow_a_pair_to_touch(tmp_path: Path) -> None:
     allowed = load_station(_station_file(tmp_path, "allowed_pairs: [[link_2, base]]\n"))
     assert allowed.allowed_pairs == (("link_2", "base"),)
     for clearance in (0.0, 0.01):
-        assert check_collisions(_bump(allowed), CollisionOptions(clearance_m=clearance)) == []
+        options = CollisionOptions(clearance_m=clearance, self_clearance_m=clearance)
+        assert check_collisions(_bump(allowed), options) == []
 
 
 @pytest.mark.parametrize(
@@ -792,7 +836,9 @@ def test_home_contacts_is_the_callers_choice_and_ignores_the_clearance(cell: Sta
     pairs = {pair for _, pair, _ in _hits(check_collisions(compiled))}
     assert pairs == {("robot link_2", "robot link_4"), ("robot link_2", "robot base")}
     for clearance in (0.0, 0.03, 0.1):
-        chosen = CollisionOptions(clearance_m=clearance, home_contacts=True)
+        chosen = CollisionOptions(
+            clearance_m=clearance, self_clearance_m=clearance, home_contacts=True
+        )
         hits = _hits(check_collisions(compiled, chosen))
         assert {pair for _, pair, _ in hits} == {("robot link_2", "robot base")}
         assert ("self_collision", ("robot link_2", "robot base"), 1) in hits
@@ -808,6 +854,9 @@ def test_home_contacts_is_the_callers_choice_and_ignores_the_clearance(cell: Sta
         {"clearance_m": -0.001},
         {"clearance_m": float("nan")},
         {"clearance_m": float("inf")},
+        {"self_clearance_m": -0.001},
+        {"self_clearance_m": float("nan")},
+        {"self_clearance_m": float("inf")},
         {"tolerance_m": 0.0},
         {"tolerance_m": -1e-4},
         {"tolerance_m": float("nan")},
@@ -820,7 +869,7 @@ def test_home_contacts_is_the_callers_choice_and_ignores_the_clearance(cell: Sta
 def test_bad_collision_options_are_usage_errors(options: dict[str, object]) -> None:
     from olp.errors import UsageError
 
-    with pytest.raises(UsageError, match=r"collision (clearance|tolerance|mode)"):
+    with pytest.raises(UsageError, match=r"collision (self-clearance|clearance|tolerance|mode)"):
         CollisionOptions(**options)  # type: ignore[arg-type]
 
 
@@ -839,7 +888,8 @@ def test_an_infinite_clearance_on_the_command_line_is_a_usage_error(
 def test_a_huge_clearance_reports_every_checked_pair_once(cell: Station) -> None:
     from olp.passes.collide import check_collisions_with_stats
 
-    found, stats = check_collisions_with_stats(_bump(cell), CollisionOptions(clearance_m=1e6))
+    huge = CollisionOptions(clearance_m=1e6, self_clearance_m=1e6)
+    found, stats = check_collisions_with_stats(_bump(cell), huge)
     assert len(found) == stats.pairs > 10
     assert all("(closer than 1000000000.0 mm)" in d.message for d in found)
 
