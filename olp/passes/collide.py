@@ -18,6 +18,12 @@ station (parts, fixtures), ``self_clearance_m`` between the robot's own bodies (
 link-tool, link-carried part). The set of checked pairs depends on neither: a larger clearance
 only adds margin, so a program that fails at one pair of clearances fails at every larger one.
 
+Shape pairs whose distance no joint motion changes (proven from the geometry, see
+:mod:`olp.collision.scene`: the UR5e's link_4 and link_6 stay 14.7 mm apart) are not checked per
+motion: no program can change them. When one lies within the clearance for its kind, one
+warning per build (kind ``clearance_unmet``) names it, its distance and the clearance asked
+for; every other pair is checked as usual.
+
 Along every motion the piecewise-linear joint path between the resolve pass's samples is proven
 free by conservative advancement (:mod:`olp.collision.advance`): if nothing is reported, every
 checked pair keeps a signed distance above its clearance minus ``tolerance_m`` everywhere on that
@@ -55,7 +61,7 @@ from olp.ir import FLANGE, Tool, is_motion
 
 if TYPE_CHECKING:
     from olp.collision.advance import Hit, Unresolved
-    from olp.collision.scene import Placed, Scene
+    from olp.collision.scene import ConstantPair, Placed, Scene
     from olp.passes.resolve import CompiledProgram, Step
     from olp.station.model import Station
 
@@ -218,6 +224,7 @@ def _runs(compiled: CompiledProgram, opts: CollisionOptions) -> tuple[list[_Run]
     scenes: dict[tuple[object, ...], Scene] = {}
     runs: list[_Run] = []
     unchecked: dict[str, Diagnostic] = {}
+    unmet: dict[tuple[str, str], tuple[float, Diagnostic]] = {}
     last = b""
     motions = (s for s in compiled.steps if is_motion(s.instruction))
     for ordinal, step in enumerate(motions):
@@ -232,13 +239,15 @@ def _runs(compiled: CompiledProgram, opts: CollisionOptions) -> tuple[list[_Run]
             scene = scenes[key] = _scene(station, step, world, opts)
             for label, radius in scene.unchecked:
                 unchecked.setdefault(label, _too_far(label, radius, step))
+            _constant_within_clearance(scene, step, opts, unmet)
         if changed or not runs or runs[-1].scene is not scene or path[0].tobytes() != last:
             runs.append(_Run(scene))
         runs[-1].steps.append(step)
         runs[-1].ordinals.append(ordinal)
         last = path[-1].tobytes()
         world.joints = path[-1]
-    return runs, _unknown_parts(compiled, opts) + list(unchecked.values())
+    warnings = [d for _, d in unmet.values()]
+    return runs, _unknown_parts(compiled, opts) + list(unchecked.values()) + warnings
 
 
 def _too_far(label: str, radius: float, step: Step) -> Diagnostic:
@@ -257,6 +266,42 @@ def _too_far(label: str, radius: float, step: Step) -> Diagnostic:
 def _clearance(kind: str, opts: CollisionOptions) -> float:
     """The clearance (m) for a pair of ``kind``: robot-internal or against the station."""
     return opts.self_clearance_m if kind == "self_collision" else opts.clearance_m
+
+
+def _constant_within_clearance(
+    scene: Scene,
+    step: Step,
+    opts: CollisionOptions,
+    unmet: dict[tuple[str, str], tuple[float, Diagnostic]],
+) -> None:
+    """Add to ``unmet`` a warning for each of the scene's constant-distance pairs closer than
+    its clearance (where a motion check would report it), the closest one per pair of names."""
+    for pair in scene.constant:
+        clearance = _clearance(pair.kind, opts)
+        names = scene.name_of(pair)
+        known = unmet.get(names)
+        if pair.distance < clearance - opts.tolerance_m / 2 and (
+            known is None or pair.distance < known[0]
+        ):
+            unmet[names] = pair.distance, _unmet(names, pair, clearance, step)
+
+
+def _unmet(names: tuple[str, str], pair: ConstantPair, clearance: float, step: Step) -> Diagnostic:
+    """The warning for a constant-distance pair within its clearance, at its first motion."""
+    what = "self-clearance" if pair.kind == "self_collision" else "clearance"
+    bodies = f"{names[0]} and {names[1]}" if pair.whole else f"shapes of {names[0]} and {names[1]}"
+    message = (
+        f"the {what} of {clearance * 1000:.1f} mm cannot be met: {bodies} are "
+        f"{pair.distance * 1000:.1f} mm apart in every position of the robot, whatever the "
+        f"program does; every other pair is checked with this {what}"
+    )
+    option = "--self-clearance" if pair.kind == "self_collision" else "--clearance"
+    hint = (
+        f"this pair allows a {what} up to {pair.distance * 1000:.1f} mm ({option}); for more, "
+        "change the station or the robot's collision model"
+    )
+    span = step.instruction.span
+    return Diagnostic("warning", "clearance_unmet", message, span, step.index, hint=hint)
 
 
 def _unknown_parts(compiled: CompiledProgram, opts: CollisionOptions) -> list[Diagnostic]:
