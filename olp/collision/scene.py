@@ -33,6 +33,34 @@ depends on the clearance a user asks for, so a larger clearance only adds margin
   that overlap at the robot's home position. One pose proves nothing about others, so this is
   never automatic.
 
+Pairs at a constant distance
+----------------------------
+Some shape pairs keep one distance in every configuration (the UR5e's link_4 and link_6 capsules:
+14.7 mm; its link_1 and the bench it stands on: 0 mm). No program changes it, so checking such a
+pair along every motion against a larger clearance would fail every program. These shape pairs
+are listed in :attr:`Scene.constant` with their distance instead of being checked per motion
+(the pass says once when one lies within the clearance asked for). Which they are is proven, not
+sampled (:class:`_Proofs`). Take the joints that move one shape relative to the other, in chain
+order from the shape ``n`` on the ancestor's side to the shape ``f`` beyond them:
+
+1. A revolute joint at either end whose axis is a symmetry axis of the shape next to it does not
+   change the distance. The last joint turns ``f`` about its axis; a sphere centred on that axis,
+   or a capsule or cylinder along it, is mapped onto itself. The first joint turns everything
+   beyond it, which as far as distances go is turning ``n`` the other way, mapped onto itself
+   the same way. Such joints are dropped from either end, repeatedly: each drop holds whatever
+   the other joints do, so the next test may use any configuration (the neutral one).
+2. If no joint is left, the distance is that of any configuration. If the joints left all turn
+   about one line ``L`` and the two shapes lie in disjoint slabs across it (coordinates along
+   ``L``: ``n`` within ``[lo_n, hi_n]``, ``f`` within ``[lo_f, hi_f]``, ``hi_n <= lo_f``) and
+   each contains the point of ``L`` on its facing side (at ``hi_n`` in ``n``, at ``lo_f`` in
+   ``f``), the distance is ``lo_f - hi_n`` in every configuration: no two points are closer
+   than their separation along ``L``, and those two points, which turning about ``L`` does not
+   move, are exactly that far apart.
+
+Everything else is checked per motion, as is a shape pair proven to overlap by more than
+:data:`ALWAYS_IN_CONTACT_M` this way (a permanent overlap stays a collision, reported at every
+motion, unless a rule above allows it).
+
 Bodies farther than :data:`MAX_REACH_M` from the origin of their frame are left out of the scene
 and listed in :attr:`Scene.unchecked`: beyond that, coal's distances lose the accuracy the check
 needs (a box of 50 km side 10 mm below a link is reported touching), so the pass reports them
@@ -42,6 +70,7 @@ instead.
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal
@@ -70,6 +99,10 @@ any cell and leaves a factor 30."""
 ALWAYS_IN_CONTACT_M = 1e-6
 """Overlap (m) two shapes must be proven to keep in every configuration to go unchecked: a
 micrometre above zero, so that rounding in coal's point depths cannot turn a gap into a proof."""
+
+ON_AXIS_M = 1e-9
+"""How close (m, and rad between directions) a point or a shape's axis must lie to a joint axis
+to count as on it, in the constant-distance proofs; proven distances hold to about this."""
 
 
 class UnsupportedChain(ValueError):
@@ -106,6 +139,20 @@ class BodyPair:
     kind: PairKind
     geometry_pairs: tuple[int, ...]
     weights: FloatArray
+
+
+@dataclass(frozen=True, slots=True)
+class ConstantPair:
+    """Shapes of two bodies proven to keep one distance in every configuration (see the module
+    text), not checked per motion: ``first`` moves with the robot; ``distance`` (m) of the
+    closest of those shape pairs; ``whole``: they are all the shape pairs of the two bodies
+    (otherwise the others are checked per motion as a :class:`BodyPair`)."""
+
+    first: int
+    second: int
+    kind: PairKind
+    distance: float
+    whole: bool
 
 
 @dataclass(frozen=True, slots=True)
@@ -157,6 +204,8 @@ class Scene:
         self.unchecked = tuple(unchecked)
         """(label, reach in m) of the bodies left out for lying beyond :data:`MAX_REACH_M`."""
         self.pairs: tuple[BodyPair, ...] = ()
+        self.constant: tuple[ConstantPair, ...] = ()
+        """Shape pairs at a proven constant distance, not in :attr:`pairs`."""
         self._pin = pin
         self._data = model.createData()
         self._gdata: Any = None
@@ -177,7 +226,7 @@ class Scene:
         compute, geometry, gdata = self._pin.computeDistance, self.geometry, self._gdata
         return min(compute(geometry, gdata, k).min_distance for k in pair.geometry_pairs)
 
-    def name_of(self, pair: BodyPair) -> tuple[str, str]:
+    def name_of(self, pair: BodyPair | ConstantPair) -> tuple[str, str]:
         return self.bodies[pair.first].label, self.bodies[pair.second].label
 
 
@@ -215,13 +264,19 @@ def build_scene(
     scene = Scene(model, builder.geometry, builder.bodies, chain, builder.unchecked)
     bound = DisplacementBound(model, robot)
     links = frozenset(frozenset(p) for p in robot.allowed_pairs)
-    fixed = _FixedPoints(scene)
-    pairs = []
+    proofs = _Proofs(scene)
+    pairs, constant = [], []
     for i, j in _candidate_pairs(model, builder.bodies, rules, links):
-        unproven = fixed.unproven(scene.bodies[i], scene.bodies[j])
-        if unproven:
-            pairs.append(_register(scene, i, j, unproven, bound))
+        a, b = scene.bodies[i], scene.bodies[j]
+        varying, distances = proofs.split_constant(a, b, proofs.unproven(a, b))
+        if varying:
+            pairs.append(_register(scene, i, j, varying, bound))
+        if distances:
+            first, second, kind = _oriented(scene, i, j)
+            whole = len(distances) == len(a.geometries) * len(b.geometries)
+            constant.append(ConstantPair(first, second, kind, min(distances), whole))
     scene.finalize(pairs)
+    scene.constant = tuple(constant)
     if rules.home_contacts and rules.self_collision:
         scene.pairs = _without_home_contacts(scene, robot)
     return scene
@@ -276,14 +331,20 @@ def _register(
     """Register the geometry pairs ``shapes`` of bodies i and j as one checked pair."""
     import pinocchio as pin
 
-    a, b = scene.bodies[i], scene.bodies[j]
-    if a.joint == 0:
-        i, j, a, b = j, i, b, a
+    i, j, kind = _oriented(scene, i, j)
     start = len(scene.geometry.collisionPairs)
     for ga, gb in shapes:
         scene.geometry.addCollisionPair(pin.CollisionPair(ga, gb))
-    kind: PairKind = "self_collision" if b.role in _ROBOT_SIDE else "collision"
+    a, b = scene.bodies[i], scene.bodies[j]
     return BodyPair(i, j, kind, tuple(range(start, start + len(shapes))), bound.pair(a, b))
+
+
+def _oriented(scene: Scene, i: int, j: int) -> tuple[int, int, PairKind]:
+    """Bodies i and j with the one that moves with the robot first, and the pair's kind."""
+    if scene.bodies[i].joint == 0:
+        i, j = j, i
+    kind: PairKind = "self_collision" if scene.bodies[j].role in _ROBOT_SIDE else "collision"
+    return i, j, kind
 
 
 def _candidate_pairs(
@@ -327,13 +388,15 @@ def _without_home_contacts(scene: Scene, robot: Robot) -> tuple[BodyPair, ...]:
     return tuple(p for p in scene.pairs if not touching(p))
 
 
-class _FixedPoints:
-    """Shape pairs of two robot-side bodies proven to overlap in every configuration (the
-    fixed-point argument of the module text).
+class _Proofs:
+    """What holds in every configuration: link and tool shape pairs proven to overlap (the
+    fixed-point argument) and shape pairs of any bodies proven to keep one distance (the
+    symmetry and slab argument), both from the module text.
 
-    The geometry is taken at the chain's neutral configuration: which point the joints between
-    two bodies leave fixed, and each shape's depth at that point, are the same in every
-    configuration, so any one configuration serves (it is not a sample of many).
+    The geometry is taken at the chain's neutral configuration: the joint axes, which point the
+    joints between two bodies leave fixed, each shape's depth at that point and its symmetry
+    about an axis are the same in every configuration, so any one configuration serves (it is
+    not a sample of many).
     """
 
     def __init__(self, scene: Scene) -> None:
@@ -347,6 +410,8 @@ class _FixedPoints:
         gdata = pin.GeometryData(scene.geometry)
         pin.updateGeometryPlacements(model, data, scene.geometry, gdata)
         self._placements = [gdata.oMg[k] for k in range(scene.geometry.ngeoms)]
+        self._axes = [None, *(self._axis(j) for j in range(1, model.njoints))]
+        self._symmetric: dict[tuple[int, int], bool] = {}
 
     def unproven(self, a: Body, b: Body) -> list[tuple[int, int]]:
         """The shape pairs (geometry ids) of bodies ``a`` and ``b`` not proven in contact."""
@@ -359,12 +424,106 @@ class _FixedPoints:
         depth = {g: self._depth(g, point) for g in (*a.geometries, *b.geometries)}
         return [(ga, gb) for ga, gb in shapes if depth[ga] + depth[gb] <= ALWAYS_IN_CONTACT_M]
 
+    def split_constant(
+        self, a: Body, b: Body, shapes: Sequence[tuple[int, int]]
+    ) -> tuple[list[tuple[int, int]], list[float]]:
+        """``shapes`` (geometry id pairs of bodies ``a`` and ``b``) split into those whose
+        distance varies or is not proven constant, and the constant distances (m) of the others.
+        A pair proven to overlap by more than :data:`ALWAYS_IN_CONTACT_M` counts as varying: it
+        stays checked."""
+        path = self._path(a.joint, b.joint)
+        varying, distances = [], []
+        for ga, gb in shapes:
+            near, far = (ga, gb) if path is not None and path[1] else (gb, ga)
+            d = None if path is None else self._constant_distance(near, far, path[0])
+            if d is None or d < -ALWAYS_IN_CONTACT_M:
+                varying.append((ga, gb))
+            else:
+                distances.append(d)
+        return varying, distances
+
     def _chain(self, joint: int) -> list[int]:
         out = []
         while joint > 0:
             out.append(joint)
             joint = self._scene.model.parents[joint]
         return out
+
+    def _path(self, first: int, second: int) -> tuple[list[int], bool] | None:
+        """The joints between two bodies' joints in chain order from the ancestor's side, and
+        whether ``first`` is the ancestor; None if neither is an ancestor of the other."""
+        up, down = self._chain(first), self._chain(second)
+        if set(up) <= set(down):
+            return sorted(set(down) - set(up)), True
+        if set(down) <= set(up):
+            return sorted(set(up) - set(down)), False
+        return None
+
+    def _constant_distance(self, near: int, far: int, joints: list[int]) -> float | None:
+        """The distance (m) of shapes ``near`` and ``far`` if ``joints`` (chain order, from
+        ``near``'s side) cannot change it, else None (steps 1 and 2 of the module text)."""
+        left = list(joints)
+        while left:
+            if self._turns_in_place(far, left[-1]):
+                left.pop()
+            elif self._turns_in_place(near, left[0]):
+                left.pop(0)
+            else:
+                break
+        if not left:
+            return self._distance(near, far)
+        axes = [self._axes[j] for j in left]
+        line = axes[0]
+        if line is None or any(axis is None or not _same_line(axis, line) for axis in axes):
+            return None
+        return self._slab_gap(near, far, line)
+
+    def _turns_in_place(self, geometry: int, joint: int) -> bool:
+        """Whether ``joint`` turning maps the shape onto itself (remembered per pair)."""
+        key = geometry, joint
+        if key not in self._symmetric:
+            axis = self._axes[joint]
+            self._symmetric[key] = axis is not None and _symmetric_about(
+                self._shape(geometry), axis
+            )
+        return self._symmetric[key]
+
+    def _axis(self, joint: int) -> tuple[FloatArray, FloatArray] | None:
+        """A revolute joint's axis as (a point on it, unit direction), world frame, neutral
+        configuration; None for a joint that does not turn (prismatic)."""
+        column = self._twists[:, self._scene.model.joints[joint].idx_v]
+        v, w = column[:3], column[3:]
+        norm = float(np.linalg.norm(w))
+        if norm < 0.5:  # a unit twist: |ω| is 1 for a revolute joint, 0 for a prismatic one
+            return None
+        return _cross(w, v) / norm**2, w / norm
+
+    def _shape(self, geometry: int) -> tuple[Any, FloatArray, FloatArray]:
+        """(coal geometry, rotation (3, 3), translation (3,)) of a shape, world frame, neutral."""
+        placement = self._placements[geometry]
+        obj = self._scene.geometry.geometryObjects[geometry].geometry
+        return obj, np.asarray(placement.rotation), np.asarray(placement.translation)
+
+    def _slab_gap(self, near: int, far: int, line: tuple[FloatArray, FloatArray]) -> float | None:
+        """The distance of two shapes turning about ``line`` relative to each other, if they
+        lie in disjoint slabs across it and touch it on their facing sides (step 2), else None."""
+        origin, direction = line
+        near_extent = _extent(self._shape(near), direction)
+        far_extent = _extent(self._shape(far), direction)
+        if near_extent is None or far_extent is None:
+            return None
+        (low_n, high_n), (low_f, high_f) = near_extent, far_extent
+        if high_n <= low_f:
+            ends = ((near, high_n), (far, low_f))
+        elif high_f <= low_n:
+            ends = ((near, low_n), (far, high_f))
+        else:
+            return None
+        for geometry, level in ends:
+            point = origin + (level - float(origin @ direction)) * direction
+            if self._depth(geometry, point) < -ON_AXIS_M:
+                return None
+        return float(abs(ends[1][1] - ends[0][1]))
 
     def _fixed_point(self, joints: set[int]) -> FloatArray | None:
         """The point (3,) that no joint in ``joints`` moves: ``v + ω × p = 0`` for every twist
@@ -387,12 +546,93 @@ class _FixedPoints:
         """How far ``point`` (3,) lies inside a shape (m; negative: its distance outside)."""
         import coal
 
+        return -self._signed_distance(geometry, coal.Sphere(0.0), np.eye(3), point)
+
+    def _distance(self, first: int, second: int) -> float:
+        """Signed distance (m) of two shapes at the neutral configuration."""
+        other = self._placements[second]
+        obj = self._scene.geometry.geometryObjects[second].geometry
+        return self._signed_distance(first, obj, other.rotation, other.translation)
+
+    def _signed_distance(
+        self, geometry: int, other: Any, rotation: FloatArray, translation: FloatArray
+    ) -> float:
+        """Signed distance (m) of a shape (neutral placement) and coal geometry ``other`` placed
+        by ``rotation`` (3, 3) and ``translation`` (3,)."""
+        import coal
+
         placement = self._placements[geometry]
         shape = coal.Transform3s(placement.rotation, placement.translation)
-        at = coal.Transform3s(np.eye(3), point)
         obj = self._scene.geometry.geometryObjects[geometry].geometry
+        there = coal.Transform3s(rotation, translation)
         result = coal.DistanceResult()
-        return -coal.distance(obj, shape, coal.Sphere(0.0), at, coal.DistanceRequest(), result)
+        return float(coal.distance(obj, shape, other, there, coal.DistanceRequest(), result))
+
+
+def _symmetric_about(
+    shape: tuple[Any, FloatArray, FloatArray], axis: tuple[FloatArray, FloatArray]
+) -> bool:
+    """Whether turning about ``axis`` (point, unit direction) maps ``shape`` onto itself: a
+    sphere centred on the axis, a capsule or cylinder along it (to :data:`ON_AXIS_M`)."""
+    import coal
+
+    obj, rotation, centre = shape
+    if not _on_line(centre, axis):
+        return False
+    if isinstance(obj, coal.Sphere):
+        return True
+    if isinstance(obj, (coal.Capsule, coal.Cylinder)):
+        return _parallel(rotation[:, 2], axis[1])
+    return False
+
+
+def _on_line(point: FloatArray, line: tuple[FloatArray, FloatArray]) -> bool:
+    origin, direction = line
+    return _parallel(point - origin, direction)
+
+
+def _same_line(a: tuple[FloatArray, FloatArray], b: tuple[FloatArray, FloatArray]) -> bool:
+    return _on_line(a[0], b) and _parallel(a[1], b[1])
+
+
+def _parallel(a: FloatArray, b: FloatArray) -> bool:
+    """Whether ``|a × b| <= ON_AXIS_M`` (for a unit ``b``: ``a`` lies along it)."""
+    c = _cross(a, b)
+    return math.sqrt(float(c @ c)) <= ON_AXIS_M
+
+
+def _cross(a: FloatArray, b: FloatArray) -> FloatArray:
+    """``a × b`` of two 3-vectors (numpy's cross costs some 20 µs per call)."""
+    return np.array(
+        [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    )
+
+
+def _extent(
+    shape: tuple[Any, FloatArray, FloatArray], direction: FloatArray
+) -> tuple[float, float] | None:
+    """The least and largest ``direction · x`` (m) over the points x of a shape (its support
+    in ``-direction`` and ``direction``); a mesh counts as its convex hull. None for a kind of
+    geometry this does not know."""
+    import coal
+
+    obj, rotation, centre = shape
+    local = rotation.T @ direction  # the direction in the shape's frame
+    middle = float(centre @ direction)
+    if isinstance(obj, coal.Convex):
+        levels = np.asarray(obj.points()) @ local
+        return middle + float(levels.min()), middle + float(levels.max())
+    if isinstance(obj, coal.Sphere):
+        half = obj.radius
+    elif isinstance(obj, coal.Capsule):
+        half = obj.halfLength * abs(local[2]) + obj.radius
+    elif isinstance(obj, coal.Cylinder):
+        half = obj.halfLength * abs(local[2]) + obj.radius * np.sqrt(max(0.0, 1 - local[2] ** 2))
+    elif isinstance(obj, coal.Box):
+        half = float(np.abs(local) @ np.asarray(obj.halfSide))
+    else:
+        return None
+    return middle - half, middle + half
 
 
 def _skew(w: FloatArray) -> FloatArray:

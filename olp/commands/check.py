@@ -68,7 +68,15 @@ def add_collision_options(parser: argparse.ArgumentParser) -> None:
         type=float,
         default=0.0,
         metavar="MM",
-        help="bodies closer than this count as colliding (default 0)",
+        help="the robot, its tool or a carried part closer than this to a part or fixture "
+        "collides (default 0)",
+    )
+    group.add_argument(
+        "--self-clearance",
+        type=float,
+        default=0.0,
+        metavar="MM",
+        help="the same between the robot's own links, tool and carried parts (default 0)",
     )
     group.add_argument(
         "--allow-contact",
@@ -94,7 +102,11 @@ def collision_options(args: argparse.Namespace) -> CollisionOptions | None:
         if len(names) != 2 or not all(names):
             raise UsageError(f"--allow-contact takes two names 'A,B', got {text!r}")
         pairs.append((names[0], names[1]))
-    return CollisionOptions(clearance_m=args.clearance / 1000.0, allowed_pairs=tuple(pairs))
+    return CollisionOptions(
+        clearance_m=args.clearance / 1000.0,
+        self_clearance_m=args.self_clearance / 1000.0,
+        allowed_pairs=tuple(pairs),
+    )
 
 
 def resolve_options(args: argparse.Namespace) -> ResolveOptions:

@@ -13,13 +13,21 @@ What is checked (coal through pinocchio's ``GeometryModel``; meshes as convex hu
 * by default the tool may touch and enter *parts* (machining, welding, screwing); it is checked
   against fixtures.
 
-The set of checked pairs does not depend on the clearance: a larger ``clearance_m`` only adds
-margin, so a program that fails at one clearance fails at every larger one.
+Two clearances: ``clearance_m`` between the robot side (links, tool, carried parts) and the
+station (parts, fixtures), ``self_clearance_m`` between the robot's own bodies (link-link,
+link-tool, link-carried part). The set of checked pairs depends on neither: a larger clearance
+only adds margin, so a program that fails at one pair of clearances fails at every larger one.
+
+Shape pairs whose distance no joint motion changes (proven from the geometry, see
+:mod:`olp.collision.scene`: the UR5e's link_4 and link_6 stay 14.7 mm apart) are not checked per
+motion: no program can change them. When one lies within the clearance for its kind, one
+warning per build (kind ``clearance_unmet``) names it, its distance and the clearance asked
+for; every other pair is checked as usual.
 
 Along every motion the piecewise-linear joint path between the resolve pass's samples is proven
 free by conservative advancement (:mod:`olp.collision.advance`): if nothing is reported, every
-checked pair keeps a signed distance above ``clearance_m - tolerance_m`` everywhere on that path,
-a thin wall between two samples included. For a joint move that path is the motion itself
+checked pair keeps a signed distance above its clearance minus ``tolerance_m`` everywhere on that
+path, a thin wall between two samples included. For a joint move that path is the motion itself
 (straight in joint space). For a linear move the real TCP line is sampled every ``step_m`` /
 ``step_rad`` and joined by joint-space chords; between samples the chord deviates from the
 exact path by a second-order amount: :func:`olp.collision.chord.chord_deviation` estimates it
@@ -53,7 +61,7 @@ from olp.ir import FLANGE, Tool, is_motion
 
 if TYPE_CHECKING:
     from olp.collision.advance import Hit, Unresolved
-    from olp.collision.scene import Placed, Scene
+    from olp.collision.scene import ConstantPair, Placed, Scene
     from olp.passes.resolve import CompiledProgram, Step
     from olp.station.model import Station
 
@@ -76,11 +84,13 @@ class Attachment:
 class CollisionOptions:
     """Settings of the collision check.
 
-    ``clearance_m``: bodies closer than this (m) collide (0: only overlap counts); it adds margin
-    to every checked pair and never changes which pairs are checked. ``tolerance_m``: the
-    resolution (within :data:`TOLERANCE_RANGE_M`): a pair closer than ``clearance_m -
-    tolerance_m`` anywhere on a motion is always reported; one that stays above ``clearance_m -
-    tolerance_m / 2`` never is (so parts resting on fixtures do not collide).
+    ``clearance_m``: the robot's links, tool and carried parts closer than this (m) to a part or
+    fixture collide (0: only overlap counts). ``self_clearance_m``: the same between the robot's
+    own bodies (link-link, link-tool, link-carried part). Each adds margin to every pair of its
+    kind and never changes which pairs are checked. ``tolerance_m``: the resolution (within
+    :data:`TOLERANCE_RANGE_M`): a pair closer than its clearance minus ``tolerance_m`` anywhere
+    on a motion is always reported; one that stays above its clearance minus ``tolerance_m / 2``
+    never is (so parts resting on fixtures do not collide).
 
     ``allowed_pairs``: pairs of body names never checked, added to the station's (robot links by
     link name, e.g. ``"link_3"``; the tool by its station name; parts and fixtures by name).
@@ -96,6 +106,7 @@ class CollisionOptions:
     """
 
     clearance_m: float = 0.0
+    self_clearance_m: float = 0.0
     tolerance_m: float = 1e-4
     allowed_pairs: tuple[tuple[str, str], ...] = ()
     self_collision: bool = True
@@ -105,10 +116,12 @@ class CollisionOptions:
     mode: Literal["advance", "samples"] = "advance"
 
     def __post_init__(self) -> None:
-        if not (math.isfinite(self.clearance_m) and self.clearance_m >= 0):
-            raise UsageError(
-                f"the collision clearance must be a finite distance >= 0, got {self.clearance_m}"
-            )
+        for what, value in (("", self.clearance_m), ("self-", self.self_clearance_m)):
+            if not (math.isfinite(value) and value >= 0):
+                raise UsageError(
+                    f"the collision {what}clearance must be a finite distance >= 0, "
+                    f"got {value * 1000:g} mm"
+                )
         low, high = TOLERANCE_RANGE_M
         if not low <= self.tolerance_m <= high:
             raise UsageError(
@@ -169,7 +182,7 @@ def check_collisions_with_stats(
             stats.rows + run_stats.rows,
             max(stats.pairs, run_stats.pairs),
         )
-    checked = _diagnostics(found, opts.clearance_m)
+    checked = _diagnostics(found, opts)
     return _bodiless_tools(compiled) + setup + unresolved + checked, stats
 
 
@@ -211,6 +224,7 @@ def _runs(compiled: CompiledProgram, opts: CollisionOptions) -> tuple[list[_Run]
     scenes: dict[tuple[object, ...], Scene] = {}
     runs: list[_Run] = []
     unchecked: dict[str, Diagnostic] = {}
+    unmet: dict[tuple[str, str], tuple[float, Diagnostic]] = {}
     last = b""
     motions = (s for s in compiled.steps if is_motion(s.instruction))
     for ordinal, step in enumerate(motions):
@@ -225,13 +239,15 @@ def _runs(compiled: CompiledProgram, opts: CollisionOptions) -> tuple[list[_Run]
             scene = scenes[key] = _scene(station, step, world, opts)
             for label, radius in scene.unchecked:
                 unchecked.setdefault(label, _too_far(label, radius, step))
+            _constant_within_clearance(scene, step, opts, unmet)
         if changed or not runs or runs[-1].scene is not scene or path[0].tobytes() != last:
             runs.append(_Run(scene))
         runs[-1].steps.append(step)
         runs[-1].ordinals.append(ordinal)
         last = path[-1].tobytes()
         world.joints = path[-1]
-    return runs, _unknown_parts(compiled, opts) + list(unchecked.values())
+    warnings = [d for _, d in unmet.values()]
+    return runs, _unknown_parts(compiled, opts) + list(unchecked.values()) + warnings
 
 
 def _too_far(label: str, radius: float, step: Step) -> Diagnostic:
@@ -245,6 +261,47 @@ def _too_far(label: str, radius: float, step: Step) -> Diagnostic:
     hint = "check the station's units and poses for this body"
     span = step.instruction.span
     return Diagnostic("error", "collision_unchecked", message, span, step.index, hint=hint)
+
+
+def _clearance(kind: str, opts: CollisionOptions) -> float:
+    """The clearance (m) for a pair of ``kind``: robot-internal or against the station."""
+    return opts.self_clearance_m if kind == "self_collision" else opts.clearance_m
+
+
+def _constant_within_clearance(
+    scene: Scene,
+    step: Step,
+    opts: CollisionOptions,
+    unmet: dict[tuple[str, str], tuple[float, Diagnostic]],
+) -> None:
+    """Add to ``unmet`` a warning for each of the scene's constant-distance pairs closer than
+    its clearance (where a motion check would report it), the closest one per pair of names."""
+    for pair in scene.constant:
+        clearance = _clearance(pair.kind, opts)
+        names = scene.name_of(pair)
+        known = unmet.get(names)
+        if pair.distance < clearance - opts.tolerance_m / 2 and (
+            known is None or pair.distance < known[0]
+        ):
+            unmet[names] = pair.distance, _unmet(names, pair, clearance, step)
+
+
+def _unmet(names: tuple[str, str], pair: ConstantPair, clearance: float, step: Step) -> Diagnostic:
+    """The warning for a constant-distance pair within its clearance, at its first motion."""
+    what = "self-clearance" if pair.kind == "self_collision" else "clearance"
+    bodies = f"{names[0]} and {names[1]}" if pair.whole else f"shapes of {names[0]} and {names[1]}"
+    message = (
+        f"the {what} of {clearance * 1000:.1f} mm cannot be met: {bodies} are "
+        f"{pair.distance * 1000:.1f} mm apart in every position of the robot, whatever the "
+        f"program does; every other pair is checked with this {what}"
+    )
+    option = "--self-clearance" if pair.kind == "self_collision" else "--clearance"
+    hint = (
+        f"this pair allows a {what} up to {pair.distance * 1000:.1f} mm ({option}); for more, "
+        "change the station or the robot's collision model"
+    )
+    span = step.instruction.span
+    return Diagnostic("warning", "clearance_unmet", message, span, step.index, hint=hint)
 
 
 def _unknown_parts(compiled: CompiledProgram, opts: CollisionOptions) -> list[Diagnostic]:
@@ -382,8 +439,6 @@ def _check_run(
 
     scene = run.scene
     path = path_run([s.path for s in run.steps if s.path is not None], scene.chain_joints)
-    lower = opts.clearance_m - opts.tolerance_m
-    upper = opts.clearance_m - opts.tolerance_m / 2
     found: list[_Found] = []
     failed: list[Diagnostic] = []
     evaluations = 0
@@ -394,6 +449,8 @@ def _check_run(
     bounds = cumulative_bounds(path, unique) if opts.mode == "advance" else unique[:, :0]
     for k, pair in enumerate(scene.pairs):
         first, second = scene.name_of(pair)
+        clearance = _clearance(pair.kind, opts)
+        lower, upper = clearance - opts.tolerance_m, clearance - opts.tolerance_m / 2
         try:
             if opts.mode == "samples":
                 hits, count = sample_hits(scene, pair, path, upper)
@@ -430,7 +487,7 @@ def _unresolved(run: _Run, first: str, second: str, exc: Unresolved) -> Diagnost
 # Diagnostics
 
 
-def _diagnostics(found: Sequence[_Found], clearance: float) -> list[Diagnostic]:
+def _diagnostics(found: Sequence[_Found], opts: CollisionOptions) -> list[Diagnostic]:
     """One diagnostic per pair of bodies and run of consecutive colliding motions."""
     groups: dict[tuple[str, str, str], list[_Found]] = {}
     for f in sorted(found, key=lambda f: (f.first, f.second, f.ordinal)):
@@ -440,7 +497,7 @@ def _diagnostics(found: Sequence[_Found], clearance: float) -> list[Diagnostic]:
         start = 0
         for k in range(1, len(items) + 1):
             if k == len(items) or items[k].ordinal != items[k - 1].ordinal + 1:
-                out.append(_diagnostic(items[start:k], clearance))
+                out.append(_diagnostic(items[start:k], _clearance(items[0].kind, opts)))
                 start = k
     return sorted(out, key=lambda d: (d.index if d.index is not None else -1, d.message))
 

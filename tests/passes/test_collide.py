@@ -321,9 +321,11 @@ def test_the_milling_helix_is_free() -> None:
         for d in clamps
     )
     assert sum("clamp" in d.message for d in clamps) >= 4 * 3
-    # The margin holds for the robot's own links too: link_2 passes 21.6 mm from the base
+    # The robot's own links have their own margin: link_2 passes 21.6 mm from the base
     # capsule at home and stays that close all the way round.
-    assert [d.message for d in near if d.kind != "collision"] == [
+    assert [d.kind for d in near] == ["collision"] * len(near)
+    own = check_collisions(compiled, CollisionOptions(self_clearance_m=0.03))
+    assert [d.message for d in own] == [
         "moves 0-400: self-collision: robot link_2 hits robot base (closer than 30.0 mm) "
         "(first at 0% of move 0)"
     ]
@@ -480,23 +482,33 @@ PTP {A1 0,A2 -90,A3 90,A4 0,A5 30,A6 0}
 PTP {A1 0,A2 45,A3 -120,A4 0,A5 -120,A6 0}
 END
 """
-SWEEP_CLEARANCES = (0.0, 1e-3, 0.01, 0.0216, 0.05, 0.1, 1.0, 1e6)
+# Both clearances (m) swept over; 21.6 mm is link_2's distance from the base capsule at home.
+SWEEP_CLEARANCES = (0.0, 1e-3, 0.0216, 0.1, 1e6)
 
 
-def test_a_larger_clearance_fails_the_issue_program_too(tmp_path: Path) -> None:
+def test_a_larger_clearance_fails_the_issue_program_too(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """link_2 runs into the base: a self collision at every clearance and self-clearance,
+    including a large --clearance with the self-clearance left at 0."""
     from olp.cli import main
 
     program = tmp_path / "bump.src"
     program.write_text(BUMP_SRC)
     station = str(REPO / "stations" / "kr6_milling_cell.yaml")
-    for clearance in ("0", "100"):
-        assert main(["check", station, str(program), "-q", "--clearance", clearance]) == 1
+    for clearance, own in itertools.product(("0", "20", "100"), ("0", "10", "100")):
+        options = ["--clearance", clearance, "--self-clearance", own]
+        assert main(["check", station, str(program), "-q", *options]) == 1
+        assert "self-collision: robot link_2 hits robot base" in capsys.readouterr().err
 
 
 def _hits(diagnostics: list[Diagnostic]) -> set[tuple[str, tuple[str, str], int]]:
-    """(kind, pair, instruction) for every motion a diagnostic covers ("moves 3-5" is three)."""
+    """(kind, pair, instruction) for every motion a collision diagnostic covers ("moves 3-5" is
+    three); the once-per-build warnings (:func:`_unmet`) are left out."""
     out = set()
     for d in diagnostics:
+        if d.kind == "clearance_unmet":
+            continue
         assert d.index is not None
         spread = re.match(r"moves (\d+)-(\d+): ", d.message)
         first, last = (int(spread[1]), int(spread[2])) if spread else (d.index, d.index)
@@ -505,41 +517,41 @@ def _hits(diagnostics: list[Diagnostic]) -> set[tuple[str, tuple[str, str], int]
     return out
 
 
+def _unmet(diagnostics: list[Diagnostic]) -> dict[tuple[str, str], tuple[float, float]]:
+    """Each clearance_unmet warning: pair names -> (constant distance, clearance asked) in mm."""
+    out = {}
+    for d in diagnostics:
+        if d.kind == "clearance_unmet":
+            assert d.severity == "warning"
+            pattern = r"the (?:self-)?clearance of ([\d.]+) mm cannot be met: (?:shapes of )?(.+) "
+            pattern += r"and (.+) are ([\d.]+) mm apart in every position"
+            match = re.match(pattern, d.message)
+            assert match is not None, d.message
+            assert (match[2], match[3]) not in out, d.message  # once per build
+            out[(match[2], match[3])] = float(match[4]), float(match[1])
+    return out
+
+
+Built = list[tuple[str, tuple[str, str], tuple[int, ...] | float]]
+
+
 def _checked_pairs(
     monkeypatch: pytest.MonkeyPatch, compiled: CompiledProgram, options: CollisionOptions
-) -> tuple[list[Diagnostic], list[tuple[tuple[str, str], tuple[int, ...]]]]:
-    """The diagnostics and every pair (names, geometry pairs) of every scene the pass built."""
+) -> tuple[list[Diagnostic], Built]:
+    """The diagnostics and every pair of every scene the pass built: ("checked", names,
+    geometry pairs) and ("constant", names, distance)."""
     from olp.collision import scene as scene_module
 
-    built: list[tuple[tuple[str, str], tuple[int, ...]]] = []
+    built: Built = []
 
     def recording(*args: object, **kwargs: object) -> Scene:
         scene = build_scene(*args, **kwargs)  # type: ignore[arg-type]
-        built.extend((scene.name_of(p), p.geometry_pairs) for p in scene.pairs)
+        built.extend(("checked", scene.name_of(p), p.geometry_pairs) for p in scene.pairs)
+        built.extend(("constant", scene.name_of(p), p.distance) for p in scene.constant)
         return scene
 
     monkeypatch.setattr(scene_module, "build_scene", recording)
     return check_collisions(compiled, options), built
-
-
-def test_the_checked_pairs_do_not_depend_on_the_clearance(
-    cell: Station, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    """The same pairs at every clearance, and what a clearance reports it reports at every
-    larger one (from half a tolerance up, the advancement's guarantee: below that a near miss
-    inside the tolerance band may go either way)."""
-    compiled = _compile(cell, _ptp(BUMP[0], 2), _ptp(BUMP[1], 3))
-    results = [
-        _checked_pairs(monkeypatch, compiled, CollisionOptions(clearance_m=c))
-        for c in SWEEP_CLEARANCES
-    ]
-    assert ("self_collision", ("robot link_2", "robot base"), 1) in _hits(results[0][0])
-    for (found, pairs), (more, more_pairs) in itertools.pairwise(results):
-        assert more_pairs == pairs == results[0][1]
-        assert _hits(found) <= _hits(more)
-    # At 1000 km every checked pair is too close: each is reported, and no other.
-    reported = {pair for _, pair, _ in _hits(results[-1][0])}
-    assert reported == {names for names, _ in results[0][1]}
 
 
 @pytest.fixture(scope="module")
@@ -547,19 +559,66 @@ def collision_cell() -> Station:
     return load_station(REPO / "stations" / "kr6_milling_collision_cell.yaml")
 
 
+def _spindle_moves(station: Station, *targets: np.ndarray) -> CompiledProgram:
+    tool = station.tools["spindle"]
+    moves = [
+        ir.JointMove(target=ir.JointTarget(joints=q), tool=tool, span=_span(k + 2))
+        for k, q in enumerate(targets)
+    ]
+    return resolve(ir.Program(name="t", instructions=tuple(moves)), station)
+
+
+def test_the_checked_pairs_do_not_depend_on_the_clearances(
+    collision_cell: Station, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The issue's program with the spindle among the clamps, over a grid of clearances and
+    self-clearances: the same pairs at every point, and what one point reports (a hit, or a
+    constant pair within its clearance) every point with both clearances at least as large
+    reports too (from half a tolerance up, the advancement's guarantee: below that a near
+    miss inside the tolerance band may go either way). Each clearance governs its own kind."""
+    compiled = _spindle_moves(collision_cell, *BUMP)
+    grid = list(itertools.product(SWEEP_CLEARANCES, repeat=2))
+    results = {
+        (c, s): _checked_pairs(
+            monkeypatch, compiled, CollisionOptions(clearance_m=c, self_clearance_m=s)
+        )
+        for c, s in grid
+    }
+    base, _ = results[(0.0, 0.0)]
+    assert ("self_collision", ("robot link_2", "robot base"), 1) in _hits(base)
+    for a, b in itertools.product(grid, repeat=2):
+        if a[0] <= b[0] and a[1] <= b[1]:
+            (found, pairs), (more, more_pairs) = results[a], results[b]
+            assert more_pairs == pairs
+            assert _hits(found) <= _hits(more), (a, b)
+            assert _unmet(found).keys() <= _unmet(more).keys(), (a, b)
+    for c, s in grid:
+        changed = {kind for kind, _, _ in _hits(results[(c, s)][0]) ^ _hits(base)}
+        if s == 0:
+            assert changed <= {"collision"}, c  # the clearance alone leaves the self pairs be
+        if c == 0:
+            assert changed <= {"self_collision"}, s
+    # At 1000 km every pair is too close: each checked one is reported, each constant one
+    # warned about once, and nothing else.
+    found, pairs = results[(1e6, 1e6)]
+    assert {pair for _, pair, _ in _hits(found)} == {n for what, n, _ in pairs if what == "checked"}
+    assert _unmet(found).keys() == {n for what, n, _ in pairs if what == "constant"}
+    assert ("robot link_3", "robot link_5") in _unmet(found)
+
+
 def test_a_clearance_only_adds_margin_on_random_moves(
     collision_cell: Station, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """Property: random joint moves of the spindle robot, two clearances c and c + gap (gap at
-    least half the tolerance): the same pairs are checked and every hit at c is a hit at
-    c + gap."""
+    """Property: random joint moves of the spindle robot, two settings of (clearance,
+    self-clearance), the second larger in either or both (by at least half the tolerance): the
+    same pairs are checked and every hit and warning of the first is one of the second."""
     from hypothesis import HealthCheck, given, settings
     from hypothesis import strategies as st
 
     robot = collision_cell.robot
-    tool = collision_cell.tools["spindle"]
     tolerance = CollisionOptions().tolerance_m
     unit = st.floats(0.0, 1.0)
+    grow = st.one_of(st.none(), st.floats(0, 0.1))
 
     @settings(
         max_examples=20,
@@ -567,21 +626,29 @@ def test_a_clearance_only_adds_margin_on_random_moves(
         derandomize=True,
         suppress_health_check=[HealthCheck.function_scoped_fixture],
     )
-    @given(st.lists(unit, min_size=12, max_size=12), st.floats(0, 0.15), st.floats(0, 0.1))
-    def check(fractions: list[float], clearance: float, gap: float) -> None:
+    @given(
+        st.lists(unit, min_size=12, max_size=12),
+        st.tuples(st.floats(0, 0.15), st.floats(0, 0.15)),
+        st.tuples(grow, grow),
+    )
+    def check(
+        fractions: list[float],
+        clearances: tuple[float, float],
+        gaps: tuple[float | None, float | None],
+    ) -> None:
         low, high = robot.limits.lower * 0.9, robot.limits.upper * 0.9
         targets = low + np.reshape(fractions, (2, 6)) * (high - low)
-        moves = [
-            ir.JointMove(target=ir.JointTarget(joints=q), tool=tool, span=_span(k + 2))
-            for k, q in enumerate(targets)
+        compiled = _spindle_moves(collision_cell, *targets)
+        larger = [
+            c if g is None else c + tolerance / 2 + g for c, g in zip(clearances, gaps, strict=True)
         ]
-        compiled = resolve(ir.Program(name="t", instructions=tuple(moves)), collision_cell)
-        lower = CollisionOptions(clearance_m=clearance)
-        upper = CollisionOptions(clearance_m=clearance + tolerance / 2 + gap)
+        lower = CollisionOptions(clearance_m=clearances[0], self_clearance_m=clearances[1])
+        upper = CollisionOptions(clearance_m=larger[0], self_clearance_m=larger[1])
         found, pairs = _checked_pairs(monkeypatch, compiled, lower)
         more, more_pairs = _checked_pairs(monkeypatch, compiled, upper)
         assert pairs == more_pairs
         assert _hits(found) <= _hits(more)
+        assert _unmet(found).keys() <= _unmet(more).keys()
 
     check()
 
@@ -650,7 +717,7 @@ def _everything_checked(monkeypatch: pytest.MonkeyPatch) -> None:
     def unproven(self: object, a: object, b: object) -> list[tuple[int, int]]:
         return [(ga, gb) for ga in a.geometries for gb in b.geometries]  # type: ignore[attr-defined]
 
-    monkeypatch.setattr(scene_module._FixedPoints, "unproven", unproven)
+    monkeypatch.setattr(scene_module._Proofs, "unproven", unproven)
 
 
 def _geometry_pairs(scene: Scene) -> dict[tuple[int, int], tuple[str, str]]:
@@ -723,6 +790,191 @@ def test_pairs_whose_axes_do_not_meet_are_not_proven(cell: Station) -> None:
 
 
 # --------------------------------------------------------------------------------------------
+# Shapes proven to keep one distance (the UR5e's link_4 and link_6)
+
+
+def _constant_shape_pairs(
+    robot: Robot, tool: Placed | None, objects: list[Placed], monkeypatch: pytest.MonkeyPatch
+) -> tuple[Scene, dict[tuple[int, int], float]]:
+    """A scene in which every candidate shape pair is checked, and the proven constant distance
+    (m) of each geometry pair (first, second) the proof gives one."""
+    from olp.collision import scene as scene_module
+
+    with monkeypatch.context() as patch:
+        patch.setattr(
+            scene_module._Proofs, "split_constant", lambda self, a, b, shapes: (list(shapes), [])
+        )
+        full = build_scene(robot, tool, [], objects, PairRules())
+    proofs = scene_module._Proofs(full)
+    owner = {g: body for body in full.bodies for g in body.geometries}
+    proven = {}
+    for pair in full.pairs:
+        for k in pair.geometry_pairs:
+            cp = full.geometry.collisionPairs[k]
+            ga, gb = cp.first, cp.second
+            _, distances = proofs.split_constant(owner[ga], owner[gb], [(ga, gb)])
+            if distances:
+                proven[(ga, gb)] = distances[0]
+    return full, proven
+
+
+def _shape_distance(scene: Scene, a: int, b: int) -> float:
+    import coal
+
+    placement = [scene._gdata.oMg[g] for g in (a, b)]
+    shape = [scene.geometry.geometryObjects[g].geometry for g in (a, b)]
+    return float(
+        coal.distance(
+            shape[0],
+            coal.Transform3s(placement[0].rotation, placement[0].translation),
+            shape[1],
+            coal.Transform3s(placement[1].rotation, placement[1].translation),
+            coal.DistanceRequest(),
+            coal.DistanceResult(),
+        )
+    )
+
+
+def _wrist_point(robot: Robot) -> np.ndarray:
+    """The origin of link_6's frame (on axes 5 and 6) in the flange frame, m (3,)."""
+    link_6 = robot.link_poses(robot.home)["link_6"]
+    return np.linalg.solve(robot.flange_poses(robot.home), link_6[:, 3])[:3]
+
+
+def _axis_shapes(robot: Robot, rng: np.random.Generator) -> tuple[Placed, list[Placed]]:
+    """A tool of shapes on the flange axis (a cylinder, a capsule, a ball) and off it (a box, an
+    off-axis ball), and fixtures on axis 1 (a pedestal ring below the base, a ball overhead)
+    and off it (a box), for the proof to accept and to refuse."""
+    on_flange = (
+        Shape("cylinder", transl(0, 0, rng.uniform(0.05, 0.15)), (0.03, 0.1)),
+        Shape("capsule", transl(0, 0, rng.uniform(0.15, 0.25)), (0.02, 0.08)),
+        Shape("sphere", transl(0, 0, rng.uniform(0.25, 0.35)), (0.04,)),
+        Shape("box", transl(*rng.uniform(-0.1, 0.1, 3)), (0.05, 0.04, 0.03)),
+        Shape("sphere", transl(rng.uniform(0.05, 0.1), 0, 0.1), (0.02,)),
+        # across the flange axis, centred where it meets axis 5: on the UR arms its slab along
+        # axis 5 touches the axis, but joint 6 turns it out of that slab
+        Shape("capsule", transl(*_wrist_point(robot)) @ roty(np.pi / 2), (0.02, 0.08)),
+    )
+    base = robot.base
+    world = [
+        Placed(
+            "pedestal", "fixture", base @ transl(0, 0, -0.3), (Shape("cylinder", size=(0.4, 0.5)),)
+        ),
+        Placed("lamp", "fixture", base @ transl(0, 0, 2.5), (Shape("sphere", size=(0.1,)),)),
+        Placed("crate", "fixture", base @ transl(0.9, 0.3, 0.2), (Shape("box", size=(0.2,) * 3),)),
+    ]
+    return Placed("t", "tool", np.eye(4), on_flange), world
+
+
+@pytest.mark.parametrize("name", _library())
+def test_shapes_proven_at_a_constant_distance_keep_it_in_every_position(
+    name: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Soundness of the constant-distance proof on every library robot (its own pairs
+    undeclared) with a tool and fixtures on and off the joint axes: every shape pair it gives
+    a distance keeps that distance at 300 random configurations of the whole joint range."""
+    rng = np.random.default_rng(4)
+    robot = dataclasses.replace(_library_robot(name), allowed_pairs=())
+    tool, world = _axis_shapes(robot, rng)
+    full, proven = _constant_shape_pairs(robot, tool, world, monkeypatch)
+    # link_1 against the pedestal and the lamp (on axis 1), link_3 and link_5 (UR: and more)
+    assert len(proven) >= 3, proven
+    lo, hi = robot.limits.lower, robot.limits.upper
+    for q in rng.uniform(lo, hi, (300, robot.dof)):
+        full.place(robot.kinematics.chain_joints(q))
+        for (a, b), distance in proven.items():
+            assert abs(_shape_distance(full, a, b) - distance) < 1e-7, (name, a, b, q)
+
+
+def test_the_ur5e_wrist_links_stay_14_7_mm_apart() -> None:
+    """The two slab proofs of the UR5e, from its DH table: link_4's capsule (r 45 mm) and
+    link_6's (r 40 mm) lie across axis 5, d5 = 99.7 mm apart along it, each touching it; link_3
+    (r 50 mm) and link_5 (r 45 mm) lie across axis 4, d4 = 133.3 mm apart. Its link_1 stands on
+    the bench, 0 mm away in every position."""
+    station = load_station(REPO / "stations" / "ur5e_screw_cell.yaml")
+    objects = [Placed(o.name, o.kind, o.pose, o.shapes) for o in station.objects]
+    scene = build_scene(station.robot, None, [], objects, PairRules())
+    constant = {scene.name_of(p): (p.distance * 1000, p.whole) for p in scene.constant}
+    assert constant[("robot link_4", "robot link_6")] == pytest.approx((99.7 - 45 - 40, True))
+    assert constant[("robot link_3", "robot link_5")] == pytest.approx((133.3 - 50 - 45, True))
+    assert constant[("robot link_1", "fixture 'bench_top'")] == pytest.approx((0.0, True))
+    checked = {scene.name_of(p) for p in scene.pairs}
+    assert not checked & constant.keys()
+    assert ("robot link_2", "fixture 'bench_top'") in checked
+
+
+def test_a_ball_off_the_turning_axis_is_not_proven() -> None:
+    """A ball on the UR5e's flange axis, 150 mm out: joint 6 turns it in place, but joint 5
+    swings it past link_4, although its slab along axis 5 lies clear of link_4's. It does not
+    touch axis 5, so the proof refuses, and its distance does vary."""
+    robot = dataclasses.replace(_library_robot("ur/ur5e"), allowed_pairs=())
+    ball = Placed("ball", "tool", np.eye(4), (Shape("sphere", transl(0, 0, 0.15), (0.02,)),))
+    scene = build_scene(robot, ball, [], [], PairRules())
+    assert not [p for p in scene.constant if "tool 'ball'" in scene.name_of(p)]
+    pair = next(p for p in scene.pairs if scene.name_of(p) == ("robot link_4", "tool 'ball'"))
+    distances = []
+    for a5 in np.radians([-90, 0, 90, 180]):
+        scene.place(robot.kinematics.chain_joints(robot.home + np.array([0, 0, 0, 0, a5, 0])))
+        distances.append(scene.distance(pair))
+    assert max(distances) - min(distances) > 0.05, distances
+
+
+def _ur_screw_program(tmp_path: Path) -> Path:
+    """From the UR5e's home with bare flange, then with the screwdriver (two scenes)."""
+    program = tmp_path / "screw.src"
+    program.write_text(
+        "DEF Screw( )\n"
+        "PTP {A1 0,A2 -90,A3 90,A4 -90,A5 -90,A6 0}\n"
+        "$TOOL = TOOL_DATA[1]\n"
+        "PTP {A1 20,A2 -80,A3 100,A4 -110,A5 -90,A6 0}\n"
+        "PTP {A1 -20,A2 -100,A3 80,A4 -70,A5 -90,A6 45}\n"
+        "PTP {A1 0,A2 -90,A3 90,A4 -90,A5 -90,A6 0}\n"
+        "END\n"
+    )
+    return program
+
+
+@pytest.mark.parametrize(
+    ("options", "warned"),
+    [
+        ([], []),
+        (
+            ["--clearance", "20"],
+            [
+                "clearance of 20.0 mm cannot be met: robot link_1 and fixture "
+                "'bench_top' are 0.0 mm apart"
+            ],
+        ),
+        (["--self-clearance", "10"], []),
+        (
+            ["--self-clearance", "20"],
+            [
+                "self-clearance of 20.0 mm cannot be met: robot link_4 and "
+                "robot link_6 are 14.7 mm apart"
+            ],
+        ),
+    ],
+)
+def test_a_ur5e_program_from_home_builds_with_a_clearance(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], options: list[str], warned: list[str]
+) -> None:
+    """Neither clearance can fail a program for the 14.7 mm between the UR5e's wrist links or
+    for link_1 standing on the bench; where the clearance asked for exceeds such a distance,
+    one warning per build says so."""
+    from olp.cli import main
+
+    station = str(REPO / "stations" / "ur5e_screw_cell.yaml")
+    out = tmp_path / "out"
+    program = str(_ur_screw_program(tmp_path))
+    assert main(["build", station, program, "--post", "ur", "-o", str(out), *options]) == 0
+    assert (out / "Screw.script").is_file()
+    lines = [line for line in capsys.readouterr().err.splitlines() if "warning[" in line]
+    assert len(lines) == len(warned)
+    for line, text in zip(lines, warned, strict=True):
+        assert "warning[clearance_unmet]" in line and text in line
+
+
+# --------------------------------------------------------------------------------------------
 # What the station and the caller allow
 
 
@@ -745,7 +997,8 @@ def test_a_station_may_allow_a_pair_to_touch(tmp_path: Path) -> None:
     allowed = load_station(_station_file(tmp_path, "allowed_pairs: [[link_2, base]]\n"))
     assert allowed.allowed_pairs == (("link_2", "base"),)
     for clearance in (0.0, 0.01):
-        assert check_collisions(_bump(allowed), CollisionOptions(clearance_m=clearance)) == []
+        options = CollisionOptions(clearance_m=clearance, self_clearance_m=clearance)
+        assert check_collisions(_bump(allowed), options) == []
 
 
 @pytest.mark.parametrize(
@@ -792,7 +1045,9 @@ def test_home_contacts_is_the_callers_choice_and_ignores_the_clearance(cell: Sta
     pairs = {pair for _, pair, _ in _hits(check_collisions(compiled))}
     assert pairs == {("robot link_2", "robot link_4"), ("robot link_2", "robot base")}
     for clearance in (0.0, 0.03, 0.1):
-        chosen = CollisionOptions(clearance_m=clearance, home_contacts=True)
+        chosen = CollisionOptions(
+            clearance_m=clearance, self_clearance_m=clearance, home_contacts=True
+        )
         hits = _hits(check_collisions(compiled, chosen))
         assert {pair for _, pair, _ in hits} == {("robot link_2", "robot base")}
         assert ("self_collision", ("robot link_2", "robot base"), 1) in hits
@@ -808,6 +1063,9 @@ def test_home_contacts_is_the_callers_choice_and_ignores_the_clearance(cell: Sta
         {"clearance_m": -0.001},
         {"clearance_m": float("nan")},
         {"clearance_m": float("inf")},
+        {"self_clearance_m": -0.001},
+        {"self_clearance_m": float("nan")},
+        {"self_clearance_m": float("inf")},
         {"tolerance_m": 0.0},
         {"tolerance_m": -1e-4},
         {"tolerance_m": float("nan")},
@@ -820,7 +1078,7 @@ def test_home_contacts_is_the_callers_choice_and_ignores_the_clearance(cell: Sta
 def test_bad_collision_options_are_usage_errors(options: dict[str, object]) -> None:
     from olp.errors import UsageError
 
-    with pytest.raises(UsageError, match=r"collision (clearance|tolerance|mode)"):
+    with pytest.raises(UsageError, match=r"collision (self-clearance|clearance|tolerance|mode)"):
         CollisionOptions(**options)  # type: ignore[arg-type]
 
 
@@ -839,9 +1097,13 @@ def test_an_infinite_clearance_on_the_command_line_is_a_usage_error(
 def test_a_huge_clearance_reports_every_checked_pair_once(cell: Station) -> None:
     from olp.passes.collide import check_collisions_with_stats
 
-    found, stats = check_collisions_with_stats(_bump(cell), CollisionOptions(clearance_m=1e6))
-    assert len(found) == stats.pairs > 10
-    assert all("(closer than 1000000000.0 mm)" in d.message for d in found)
+    huge = CollisionOptions(clearance_m=1e6, self_clearance_m=1e6)
+    found, stats = check_collisions_with_stats(_bump(cell), huge)
+    errors = [d for d in found if d.severity == "error"]
+    assert len(errors) == stats.pairs > 10
+    assert all("(closer than 1000000000.0 mm)" in d.message for d in errors)
+    # link_5 is a ball about the wrist centre, on axes 4 and 5: always 310 mm from link_3
+    assert _unmet(found) == {("robot link_3", "robot link_5"): (310.0, 1e9)}
 
 
 def test_zero_length_motions_are_checked_like_any_other(cell: Station) -> None:
