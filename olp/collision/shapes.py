@@ -31,7 +31,7 @@ def coal_geometry(shape: Shape) -> Any:
         return coal.Cylinder(*shape.size)
     if shape.kind == "capsule":
         return coal.Capsule(*shape.size)
-    vertices, faces = _hull(str(shape.mesh), shape.scale)
+    vertices, faces = mesh_hull(shape)
     points = coal.StdVec_Vec3s()
     for v in vertices:
         points.append(v)
@@ -42,7 +42,11 @@ def coal_geometry(shape: Shape) -> Any:
 
 
 def mesh_hull(shape: Shape) -> tuple[FloatArray, NDArray[np.int64]]:
-    """Vertices (V, 3) m and triangles (F, 3) of the convex hull of a mesh shape, shape frame."""
+    """Vertices (V, 3) m and triangles (F, 3) of the convex hull of a mesh shape, shape frame:
+    the hull the station loader read and checked, or, for a shape made in code, the same
+    reading and checks (:func:`olp.station.meshes.mesh_hull`: a bad mesh is a MeshError)."""
+    if shape.hull is not None:
+        return shape.hull.vertices, shape.hull.faces
     if shape.mesh is None:
         raise ValueError(f"a {shape.kind} has no mesh file")
     return _hull(shape.mesh, shape.scale)
@@ -50,11 +54,11 @@ def mesh_hull(shape: Shape) -> tuple[FloatArray, NDArray[np.int64]]:
 
 @lru_cache(maxsize=64)
 def _hull(path: str, scale: float) -> tuple[FloatArray, NDArray[np.int64]]:
-    import trimesh
+    from pathlib import Path
 
-    mesh: Any = trimesh.load(path, force="mesh")
-    mesh.apply_scale(scale)
-    hull = mesh.convex_hull
+    from olp.station.meshes import mesh_hull as read_hull
+
+    hull = read_hull(Path(path), scale)
     vertices = np.ascontiguousarray(hull.vertices, dtype=np.float64)
     faces = np.ascontiguousarray(hull.faces, dtype=np.int64)
     vertices.setflags(write=False)
