@@ -31,7 +31,7 @@ from typing import Any
 from lark import Lark
 
 from olp.frontends.krl import load_krl, parse_krl
-from olp.frontends.krl_parse import gc_paused
+from olp.frontends.krl.parse import gc_paused
 from olp.resources import data_path
 
 

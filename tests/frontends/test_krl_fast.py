@@ -12,9 +12,9 @@ from hypothesis import strategies as st
 from olp import ir
 from olp.errors import ParseError
 from olp.frontends.krl import KrlData, KrlResult, load_config_dat, parse_dat, parse_krl
-from olp.frontends.krl_ast import FastMotion, Source
-from olp.frontends.krl_fast import materialise, scan_line
-from olp.frontends.krl_parse import parse_module
+from olp.frontends.krl.ast import FastMotion, Source
+from olp.frontends.krl.fast import materialise, scan_line
+from olp.frontends.krl.parse import parse_module
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 MILLING = EXAMPLES / "facing_mill.src"

@@ -12,7 +12,6 @@ import pytest
 
 from olp import ir
 from olp.errors import ParseError, UsageError
-from olp.frontends import krl_lower
 from olp.frontends.krl import (
     KrlData,
     KrlResult,
@@ -23,6 +22,7 @@ from olp.frontends.krl import (
     parse_dat,
     parse_krl,
 )
+from olp.frontends.krl import lower as krl_lower
 from olp.vendors.kuka import configuration_from_status_turn, frame_to_pose
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"

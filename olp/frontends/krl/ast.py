@@ -1,8 +1,8 @@
 """The KRL frontend's shared vocabulary: source files, the AST, and what a run reports.
 
-The AST is what :mod:`olp.frontends.krl_parse` makes of ``grammars/krl.lark``'s parse tree (and
-what :mod:`olp.frontends.krl_fast` makes of simple motion lines without lark); it is lowered by
-:mod:`olp.frontends.krl_lower`. Every node knows its :class:`~olp.ir.SourceSpan`.
+The AST is what :mod:`olp.frontends.krl.parse` makes of ``grammars/krl.lark``'s parse tree (and
+what :mod:`olp.frontends.krl.fast` makes of simple motion lines without lark); it is lowered by
+:mod:`olp.frontends.krl.lower`. Every node knows its :class:`~olp.ir.SourceSpan`.
 """
 
 from __future__ import annotations
@@ -248,10 +248,10 @@ class MotionStmt:
 
 @dataclass(frozen=True, slots=True)
 class FastMotion:
-    """A simple motion line read without lark (see :mod:`olp.frontends.krl_fast`).
+    """A simple motion line read without lark (see :mod:`olp.frontends.krl.fast`).
 
     ``keyword {[TYPE:] NAME number, ...} [approx]``: the values are already numbers; the line's
-    text is kept so that :func:`olp.frontends.krl_fast.materialise` can rebuild the full
+    text is kept so that :func:`olp.frontends.krl.fast.materialise` can rebuild the full
     :class:`MotionStmt` (with a span per member) whenever the lowering needs more than the
     common case.
     """

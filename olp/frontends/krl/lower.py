@@ -13,7 +13,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from olp import ir
-from olp.frontends.krl_ast import (
+from olp.frontends.krl.ast import (
     Assign,
     Binary,
     Block,
@@ -36,16 +36,16 @@ from olp.frontends.krl_ast import (
     WaitFor,
     WaitSec,
 )
-from olp.frontends.krl_data import OTHER_REASONS, KrlData
-from olp.frontends.krl_motion import Motions
-from olp.frontends.krl_state import (
+from olp.frontends.krl.data import OTHER_REASONS, KrlData
+from olp.frontends.krl.motion import Motions
+from olp.frontends.krl.state import (
     DEFAULT_VEL_CP,
     Context,
     KrlResult,
     State,
     build_instructions,
 )
-from olp.frontends.krl_values import (
+from olp.frontends.krl.values import (
     Bool,
     Num,
     Signal,

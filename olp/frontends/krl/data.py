@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 from olp import ir
 from olp.errors import ParseError
-from olp.frontends.krl_ast import (
+from olp.frontends.krl.ast import (
     Assign,
     DatBlock,
     Decl,
@@ -35,8 +35,8 @@ from olp.frontends.krl_ast import (
     Text,
     Var,
 )
-from olp.frontends.krl_parse import gc_paused, parse_module
-from olp.frontends.krl_values import (
+from olp.frontends.krl.parse import gc_paused, parse_module
+from olp.frontends.krl.values import (
     NOT_SET,
     ArrayValue,
     ElementKey,

@@ -2,7 +2,7 @@
 
 Milling programs are 10k-100k lines like ``LIN {X 12.5,Y -3,Z 6.35,A 180,B 0,C -180} C_DIS``.
 lark spends most of its time on them, so :func:`scan_line` recognises exactly this shape with one
-regular expression and returns a :class:`~olp.frontends.krl_ast.FastMotion`; every other line
+regular expression and returns a :class:`~olp.frontends.krl.ast.FastMotion`; every other line
 (and any line this module is not sure about) goes through the full grammar.
 
 The accepted shape is a strict subset of what ``grammars/krl.lark`` accepts, chosen so that the
@@ -20,7 +20,7 @@ from __future__ import annotations
 import re
 
 from olp import ir
-from olp.frontends.krl_ast import Aggregate, FastMotion, Member, MotionStmt, Num
+from olp.frontends.krl.ast import Aggregate, FastMotion, Member, MotionStmt, Num
 
 # A character that continues a KRL name: where a keyword or member name must not be followed by one.
 _NAME_CHAR = r"[a-z0-9_$]"

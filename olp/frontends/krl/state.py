@@ -3,8 +3,8 @@
 :class:`Core` holds the state (:class:`State`: speeds, approximation, tool, base; :class:`Track`:
 where the robot is, as far as the text tells), the variables, the reports (ignored lines, notes),
 value helpers that raise located errors, and the assignments of system variables (``$VEL``,
-``$APO``, ``$TOOL``, ``$BASE``, ``$OUT``, ...). :mod:`olp.frontends.krl_inline` (BAS and WITH),
-:mod:`olp.frontends.krl_motion` (motions) and :mod:`olp.frontends.krl_lower` (the statement walk,
+``$APO``, ``$TOOL``, ``$BASE``, ``$OUT``, ...). :mod:`olp.frontends.krl.inline` (BAS and WITH),
+:mod:`olp.frontends.krl.motion` (motions) and :mod:`olp.frontends.krl.lower` (the statement walk,
 calls and loops) build on it, in that order.
 
 Cartesian targets are collected as KRL values (mm, deg) and converted to poses in one vectorised
@@ -24,7 +24,7 @@ import numpy as np
 
 from olp import ir
 from olp.errors import ParseError
-from olp.frontends.krl_ast import (
+from olp.frontends.krl.ast import (
     Aggregate,
     Assign,
     EnumValue,
@@ -38,8 +38,8 @@ from olp.frontends.krl_ast import (
     Stmt,
     Var,
 )
-from olp.frontends.krl_data import DataOps, KrlData, text_value
-from olp.frontends.krl_values import (
+from olp.frontends.krl.data import DataOps, KrlData, text_value
+from olp.frontends.krl.values import (
     AXES,
     CARTESIAN,
     EXTERNAL,

@@ -1,11 +1,11 @@
 """KUKA KRL frontend (KR C4, KSS 8): a ``.src`` program (+ its ``.dat``) -> :class:`olp.ir.Program`.
 
-Pipeline: :mod:`~olp.frontends.krl_parse` (grammar ``grammars/krl.lark``, LALR, positions
-propagated; simple motion lines through the fast path of :mod:`~olp.frontends.krl_fast`) ->
-:mod:`~olp.frontends.krl_ast` nodes -> :mod:`~olp.frontends.krl_lower` (tracks the controller's
+Pipeline: :mod:`~olp.frontends.krl.parse` (grammar ``grammars/krl.lark``, LALR, positions
+propagated; simple motion lines through the fast path of :mod:`~olp.frontends.krl.fast`) ->
+:mod:`~olp.frontends.krl.ast` nodes -> :mod:`~olp.frontends.krl.lower` (tracks the controller's
 motion state) -> IR. Data lists (the module's ``.dat``, a ``$config.dat``) are read by
-:mod:`~olp.frontends.krl_data`; constant expressions are evaluated by
-:mod:`~olp.frontends.krl_values`.
+:mod:`~olp.frontends.krl.data`; constant expressions are evaluated by
+:mod:`~olp.frontends.krl.values`.
 
 What is lowered
 ---------------
@@ -62,8 +62,8 @@ What is lowered
   back to a plain variable argument); recursion is an error. Other calls become
   :class:`~olp.ir.Call` (arguments as source text).
 * **FOR** loops with constant integer bounds are unrolled (at most
-  :data:`~olp.frontends.krl_lower.MAX_FOR_ITERATIONS` iterations, and
-  :data:`~olp.frontends.krl_lower.MAX_LOWERED_STATEMENTS` statements in all). Other control
+  :data:`~olp.frontends.krl.lower.MAX_FOR_ITERATIONS` iterations, and
+  :data:`~olp.frontends.krl.lower.MAX_LOWERED_STATEMENTS` statements in all). Other control
   flow (``IF``, ``WHILE``, ``LOOP``, ``REPEAT``, ``SWITCH``, FOR with other bounds) is ignored
   when lowering its bodies would change nothing (variables they assign become unknown), and
   rejected otherwise, naming the construct and its line. ``SPLINE ... ENDSPLINE`` blocks and
@@ -86,10 +86,10 @@ from pathlib import Path
 
 from olp import ir
 from olp.errors import UsageError
-from olp.frontends.krl_ast import IgnoredLine, Note, Source, SourceSet, StatusTurn
-from olp.frontends.krl_data import KrlData, read_data_list
-from olp.frontends.krl_lower import DEFAULT_VEL_CP, KrlResult, lower_module
-from olp.frontends.krl_parse import gc_paused, parse_module
+from olp.frontends.krl.ast import IgnoredLine, Note, Source, SourceSet, StatusTurn
+from olp.frontends.krl.data import KrlData, read_data_list
+from olp.frontends.krl.lower import DEFAULT_VEL_CP, KrlResult, lower_module
+from olp.frontends.krl.parse import gc_paused, parse_module
 
 __all__ = [
     "DEFAULT_VEL_CP",

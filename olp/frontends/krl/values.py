@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 from typing import TypeAlias
 
 from olp import ir
-from olp.frontends.krl_ast import (
+from olp.frontends.krl.ast import (
     Aggregate,
     Binary,
     Bits,

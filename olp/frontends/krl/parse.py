@@ -1,9 +1,9 @@
-"""KRL text -> :class:`~olp.frontends.krl_ast.Module`: lark, a Transformer, and located errors.
+"""KRL text -> :class:`~olp.frontends.krl.ast.Module`: lark, a Transformer, and located errors.
 
 Speed
 -----
 lark (pure Python, LALR, positions propagated) needs ~0.2 ms per motion line, too slow for
-100k-line milling programs. So :func:`parse_module` first lets :func:`~olp.frontends.krl_fast.
+100k-line milling programs. So :func:`parse_module` first lets :func:`~olp.frontends.krl.fast.
 scan_line` pick out the simple motion lines; each run of consecutive ones is replaced by a single
 placeholder token (``\\x00``) followed by the run's line breaks, so lark parses the rest of the
 file with every line number unchanged, and the placeholder becomes the run's statements. If that
@@ -32,7 +32,7 @@ from lark.tree import Meta
 
 from olp import ir
 from olp.errors import ParseError
-from olp.frontends.krl_ast import (
+from olp.frontends.krl.ast import (
     Aggregate,
     Assign,
     Binary,
@@ -66,7 +66,7 @@ from olp.frontends.krl_ast import (
     WaitFor,
     WaitSec,
 )
-from olp.frontends.krl_fast import scan_line, signed_number
+from olp.frontends.krl.fast import scan_line, signed_number
 from olp.resources import data_path
 
 _FAST_RUN = "\x00"

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from olp.frontends.krl_ast import (
+from olp.frontends.krl.ast import (
     Aggregate,
     Assign,
     CallStmt,
@@ -19,11 +19,11 @@ from olp.frontends.krl_ast import (
     Expr,
     FuncCall,
 )
-from olp.frontends.krl_state import (
+from olp.frontends.krl.state import (
     SYSTEM_REASONS,
     Core,
 )
-from olp.frontends.krl_values import (
+from olp.frontends.krl.values import (
     Unknown,
 )
 

@@ -1,7 +1,7 @@
 """KRL lowering of motions: PTP/LIN/CIRC, their spline and _REL forms, and the fast path.
 
 Targets are inline aggregates or named points; Cartesian ones stay KRL values (mm, deg) until
-:func:`olp.frontends.krl_state.build_instructions`. See :mod:`olp.frontends.krl` for the rules.
+:func:`olp.frontends.krl.state.build_instructions`. See :mod:`olp.frontends.krl` for the rules.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from olp import ir
-from olp.frontends.krl_ast import (
+from olp.frontends.krl.ast import (
     Aggregate,
     Expr,
     FastMotion,
@@ -21,15 +21,15 @@ from olp.frontends.krl_ast import (
     StatusTurn,
     Var,
 )
-from olp.frontends.krl_fast import materialise
-from olp.frontends.krl_inline import InlineForms
-from olp.frontends.krl_state import (
+from olp.frontends.krl.fast import materialise
+from olp.frontends.krl.inline import InlineForms
+from olp.frontends.krl.state import (
     DEFAULT_VEL_CP,
     Cartesian,
     Pending,
     Target,
 )
-from olp.frontends.krl_values import (
+from olp.frontends.krl.values import (
     AXES,
     CARTESIAN,
     EXTERNAL,
