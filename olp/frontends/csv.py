@@ -87,10 +87,18 @@ ANGLE_UNITS = {"deg": math.pi / 180.0, "rad": 1.0}
 EULER_ALIASES = {"wpr": "xyz", "abc": "ZYX"}
 
 _DELIMITERS: tuple[str | None, ...] = (",", ";", "\t", "|", None)
-_NUMBER = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
+# Both patterns are linear in the text: no two adjacent repeats can match the same characters
+# (``[0-9]+\.?[0-9]*`` or ``\s*[)]?\s*`` backtrack quadratically on a long cell).
+_NUMBER = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 _UNIT = re.compile(
-    r"(?:[\[(]\s*|_|\s)(mm|m|in|inch|deg|rad)(?:\s*/\s*(s|sec|min))?\s*[\])]?\s*$", re.IGNORECASE
+    r"(?:[\[(]\s*|_|\s)(mm|m|in|inch|deg|rad)(?:\s*/\s*(s|sec|min))?\s*(?:[\])]\s*)?$",
+    re.IGNORECASE,
 )
+EXCERPT_CHARS = 40
+"""Longest piece of a file's text a message quotes; the rest is summarised by its length."""
+MAX_INDEX = 2**53 - 1
+"""Largest index (in size) a 7-column row may give: every integer up to it survives the float
+the row is read as, so the target's name is the number in the file."""
 
 
 # ------------------------------------------------------------------------------------------------
@@ -414,10 +422,12 @@ class _Head:
         count = self._header_count(content)
         if count >= len(content):
             number, text = content[-1]
-            raise self._error("no data rows after the header rows", number, text)
+            raise self._error("no data rows after the header rows", number, text, _quote_hint(text))
         headers = content[:count]
         number, first = content[count]
         delimiter, decimal = self._separators(number, first, count)
+        if headers:
+            self._match_header(headers[-1], number, first, delimiter)
         cells = _split(first, delimiter)
         columns = LAYOUTS.get(len(cells))
         if columns is None:
@@ -435,6 +445,19 @@ class _Head:
 
     def _error(self, message: str, line: int, text: str, hint: str | None = None) -> ParseError:
         return ParseError(message, ir.SourceSpan(self.filename, line, 1), text, hint)
+
+    def _match_header(
+        self, header: tuple[int, str], line: int, text: str, delimiter: str | None
+    ) -> None:
+        """The first data row has as many cells as the header row right above it, which names
+        the columns. A different count means the rows are not what the header says (``x,y,z``
+        over ``400,5,0,500`` must not become x, y, z and a speed). A one-cell row is a title."""
+        number, names = header
+        expected = len(_split(names.strip(), delimiter))
+        if expected > 1 and len(_split(text, delimiter)) != expected:
+            what = f"cells like the header row on line {number} ({_excerpt(names.strip())})"
+            hint = "make every row match the header; start a title row with '#'"
+            raise _count_error(text, line, delimiter, expected, what, self.filename, hint)
 
     def _header_count(self, content: list[tuple[int, str]]) -> int:
         if self.options.header is not None:
@@ -575,6 +598,21 @@ class _HeaderUnits:
         self.units.setdefault(kind, (unit, cell))
 
 
+def _quote_hint(text: str) -> str | None:
+    unquoted = text.replace('"', "").replace("'", "")
+    if unquoted != text and _has_number(unquoted):
+        return "olp reads plain numbers: remove the quotes around them"
+    return None
+
+
+def _excerpt(text: str) -> str:
+    """``text`` quoted for a message, cut to :data:`EXCERPT_CHARS` characters (a 20 MB row
+    must not become a 20 MB message)."""
+    if len(text) <= EXCERPT_CHARS:
+        return repr(text)
+    return f"{text[:EXCERPT_CHARS]!r}... ({len(text)} characters)"
+
+
 def _is_content(line: str) -> bool:
     stripped = line.strip()
     return bool(stripped) and not stripped.startswith("#")
@@ -695,16 +733,40 @@ def _check_row(text: str, line: int, layout: CsvLayout, filename: str) -> None:
     spans = _cell_spans(text, layout.delimiter)
     expected = len(layout.columns)
     if len(spans) != expected:
-        names = ", ".join(layout.columns)
-        raise ParseError(
-            f"expected {expected} columns ({names}), found {len(spans)}",
-            ir.SourceSpan(filename, line, 1, line, len(text) + 1),
-            text,
-        )
+        what = f"columns ({', '.join(layout.columns)})"
+        raise _count_error(text, line, layout.delimiter, expected, what, filename)
     for (start, end), column in zip(spans, layout.columns, strict=True):
         if not _is_number(text[start:end], layout.decimal):
             what = "an integer" if column == "index" else "a number"
             raise _cell_error(text, line, (start, end), filename, f"expected {what}", column)
+
+
+def _count_error(
+    text: str,
+    line: int,
+    delimiter: str | None,
+    expected: int,
+    what: str,
+    filename: str,
+    hint: str | None = None,
+) -> ParseError:
+    """A row with the wrong number of cells, pointing at the first extra cell or at the end of
+    the row where cells are missing."""
+    spans = _cell_spans(text, delimiter)
+    found = len(spans)
+    if found > expected:
+        start, end = spans[expected]
+        cell = text[start:end]
+        column = start + len(cell) - len(cell.lstrip()) + 1
+        detail = f"the first extra cell is {_excerpt(cell.strip())}"
+        width = max(len(cell.strip()), 1)
+        span = ir.SourceSpan(filename, line, column, line, column + width)
+    else:
+        column = len(text.rstrip()) + 1
+        missing = expected - found
+        detail = f"{missing} cell{'s' if missing > 1 else ''} missing at the end of the row"
+        span = ir.SourceSpan(filename, line, column)
+    return ParseError(f"expected {expected} {what}, found {found}: {detail}", span, text, hint)
 
 
 def _cell_error(
@@ -713,7 +775,7 @@ def _cell_error(
     raw = text[cell[0] : cell[1]]
     found = raw.strip()
     col = cell[0] + len(raw) - len(raw.lstrip()) + 1
-    shown = repr(found) if found else "nothing"
+    shown = _excerpt(found) if found else "nothing"
     return ParseError(
         f"column {column!r}: {expected}, found {shown}",
         ir.SourceSpan(filename, line, col, line, col + max(len(found), 1)),
@@ -732,8 +794,9 @@ def _check_values(chunk: CsvChunk, block: _Block, layout: CsvLayout, filename: s
             bad[:, col] |= ~(chunk.values[:, col] / layout.speed_divisor > 0)
             expected[col] = "a finite speed > 0"
         if "index" in layout.columns:
-            bad[:, -1] |= np.floor(chunk.values[:, -1]) != chunk.values[:, -1]
-            expected[-1] = "an integer"
+            index = chunk.values[:, -1]
+            bad[:, -1] |= (np.floor(index) != index) | (np.abs(index) > MAX_INDEX)
+            expected[-1] = f"an integer from -{MAX_INDEX} to {MAX_INDEX}"
     if not np.any(bad):
         return
     row, col = (int(v) for v in np.unravel_index(int(np.argmax(bad)), bad.shape))
