@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from olp import ir
-from olp.api import build
+from olp.api import build, parse
 from olp.errors import OlpError, ParseError, UsageError
 from olp.frontends.dsl import load_dsl, run_dsl
 from olp.frontends.dsl_process import ProgramRunError
@@ -97,6 +97,14 @@ def test_the_cli_takes_a_timeout(tmp_path: Path) -> None:
     assert f"{path}:3:1: error running the program: the program did not finish within 1 s" in (
         done.stderr
     )
+
+
+def test_the_library_takes_a_timeout(tmp_path: Path, station: Station) -> None:
+    path = program(tmp_path, HOME + "import time\ntime.sleep(60)\n")
+    with pytest.raises(ProgramRunError, match="did not finish within 1 s"):
+        parse(path, station=station, timeout=1)
+    with pytest.raises(ProgramRunError, match="did not finish within 1 s"):
+        build(station, path, timeout=1.0)
 
 
 @pytest.mark.parametrize("value", ["0", "-1", "nan"])
