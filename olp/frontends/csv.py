@@ -38,6 +38,10 @@ or whitespace), a decimal comma (with a ``;``, tab or whitespace delimiter) and 
 detected or given. Units come from header cells such as ``x [mm]``, ``x (m)``, ``x_in``,
 ``a [rad]``, ``speed [mm/min]``; without any, mm, degrees and mm/s. A unit given in the options
 that contradicts the header is an error. Lines that are blank or start with ``#`` are skipped.
+The header row right above the data names the columns: a first data row with another number
+of cells, or a name olp knows over a column it reads as something else (``rz`` over the speed
+column, ``a1..a6`` or ``j1..j6`` joint values, ``i, j, k`` tool vectors, quaternions, ``y``
+first), is an error rather than a file read another way. A one-cell row above is a title.
 
 The file is read in blocks of :attr:`CsvOptions.chunk_bytes` and each block is parsed by numpy
 in one call, so memory stays bounded by the block size plus the arrays the result needs
@@ -436,6 +440,8 @@ class _Head:
                 "z and three angles) or 7 (x, y, z, three angles and an index)"
             )
             raise self._error(message, number, first)
+        if headers:
+            self._match_names(headers[-1], columns, delimiter)
         self.layout = self._layout(columns, delimiter, decimal, headers)
         self.ignored = tuple(
             IgnoredLine(ir.SourceSpan(filename, n, 1), text.strip(), "header row")
@@ -458,6 +464,34 @@ class _Head:
             what = f"cells like the header row on line {number} ({_excerpt(names.strip())})"
             hint = "make every row match the header; start a title row with '#'"
             raise _count_error(text, line, delimiter, expected, what, self.filename, hint)
+
+    def _match_names(
+        self, header: tuple[int, str], columns: tuple[str, ...], delimiter: str | None
+    ) -> None:
+        """A header cell olp recognises names what olp reads in its column: ``speed`` over a
+        4th column, an angle over the 4th to 6th. ``x,y,z,rz`` over four numbers, ``a1..a6``
+        joint values or ``i,j,k`` tool vectors would otherwise be read as something else."""
+        number, text = header
+        spans = _cell_spans(text, delimiter)
+        if len(spans) != len(columns):
+            return
+        for (start, end), column in zip(spans, columns, strict=True):
+            kind = HEADER_NAMES.get(_base_name(text[start:end]))
+            expected = _COLUMN_KINDS[column]
+            if kind is None or kind == expected:
+                continue
+            cell = text[start:end].strip()
+            column_at = start + text[start:end].index(cell) + 1 if cell else start + 1
+            raise ParseError(
+                f"the header names {_excerpt(cell)} ({_KIND_TEXT[kind]}) where olp reads "
+                f"{_KIND_TEXT[expected]}: a row of {len(columns)} numbers is "
+                f"{', '.join(columns)}",
+                ir.SourceSpan(self.filename, number, column_at, number, column_at + len(cell)),
+                text,
+                "olp reads x, y, z (3 columns), then a speed (4), or three angles (6) and "
+                "an index (7): reorder the columns; joint values, tool vectors and "
+                "quaternions need converting",
+            )
 
     def _header_count(self, content: list[tuple[int, str]]) -> int:
         if self.options.header is not None:
@@ -596,6 +630,44 @@ class _HeaderUnits:
                 f"{previous[0]!r}; olp needs one length unit and one angle unit per file"
             )
         self.units.setdefault(kind, (unit, cell))
+
+
+HEADER_NAMES: dict[str, str] = {
+    "x": "x",
+    "y": "y",
+    "z": "z",
+    **dict.fromkeys(("speed", "feed", "feedrate", "f", "v", "vel", "velocity"), "speed"),
+    **dict.fromkeys(
+        ("a", "b", "c", "w", "p", "r", "rx", "ry", "rz", "roll", "pitch", "yaw"), "angle"
+    ),
+    **dict.fromkeys(("alpha", "beta", "gamma", "a1", "a2", "a3"), "angle"),
+    **dict.fromkeys(("index", "idx", "id", "nr", "no", "number"), "index"),
+    **dict.fromkeys(("i", "j", "k", "nx", "ny", "nz", "vx", "vy", "vz"), "vector"),
+    **dict.fromkeys(("qw", "qx", "qy", "qz", "q0", "q1", "q2", "q3", "q4"), "quaternion"),
+    **dict.fromkeys(("a4", "a5", "a6", "j1", "j2", "j3", "j4", "j5", "j6"), "joint"),
+}
+"""Header cell names (without units, lower case) olp recognises, and what they name. A
+recognised name over a column olp reads as something else is an error."""
+_COLUMN_KINDS = {"x": "x", "y": "y", "z": "z", "speed": "speed", "index": "index"}
+_COLUMN_KINDS.update(dict.fromkeys(("a1", "a2", "a3"), "angle"))
+_KIND_TEXT = {
+    "x": "the x coordinate",
+    "y": "the y coordinate",
+    "z": "the z coordinate",
+    "speed": "a speed",
+    "angle": "an angle",
+    "index": "an index",
+    "vector": "a tool direction vector component",
+    "quaternion": "a quaternion component",
+    "joint": "a joint value",
+}
+
+
+def _base_name(cell: str) -> str:
+    """A header cell's name without its unit (``X [mm]`` -> ``x``), lower case."""
+    text = " " + cell.strip().strip("\"'")
+    match = _UNIT.search(text)
+    return (text[: match.start()] if match else text).strip().lower()
 
 
 def _quote_hint(text: str) -> str | None:

@@ -26,10 +26,11 @@ The child's ``sys.path`` does not start with the working directory (a ``numpy.py
 is not imported) and does start with the folder that holds this olp, so the child runs the same
 olp as the caller. The program gets the station as a pickle of the caller's
 :class:`~olp.station.model.Station` (the same object, including stations built in memory, and
-no second read of a file that may have changed), its ``--set`` values, an empty stdin and the
-caller's stdout and stderr (its prints reach the user as they happen, like any script's).
-``PYTHONHASHSEED`` is 0 unless the user set it, so a program that iterates over a set of
-strings writes the same robot program on every run.
+no second read of a file that may have changed), its ``--set`` values, ``sys.argv`` as
+``python prog.py`` would set it, an empty stdin and the caller's stdout and stderr (its prints
+reach the user as they happen, like any script's). ``PYTHONHASHSEED`` is 0 unless the user set
+it, so a program that iterates over a set of strings writes the same robot program on every
+run.
 """
 
 from __future__ import annotations
@@ -110,13 +111,15 @@ def run_in_child(
     station, params : as for :func:`olp.frontends.dsl.run_dsl`.
     timeout : seconds (> 0) before the child is killed; None for no limit.
 
-    Raises the program's own located :class:`~olp.errors.OlpError`, or a ParseError for a
-    timeout, an early or failed exit, a crash or an unreadable result.
+    Raises the program's own located :class:`~olp.errors.OlpError`, a
+    :class:`ProgramRunError` for a timeout, an early or failed exit, a crash or an unreadable
+    result, or a :class:`~olp.errors.UsageError` when no child process can be started.
     """
     limit = check_timeout(timeout)
     program = _Program(os.fspath(path), source)
-    with tempfile.TemporaryDirectory(prefix="olp-dsl-") as folder:
-        job = Path(folder)
+    # The program may have changed the folder's permissions: cleaning up must not fail olp.
+    with tempfile.TemporaryDirectory(prefix="olp-dsl-", ignore_cleanup_errors=True) as folder:
+        job = Path(folder).resolve()
         _write_request(job, program, station, params)
         code = _run(job, limit)
         return _outcome(job, program, code, limit)
@@ -158,9 +161,13 @@ def _write_request(
         data = pickle.dumps(request, protocol=pickle.HIGHEST_PROTOCOL)
     except Exception as exc:
         raise UsageError(
-            f"the station or the parameters cannot be passed to the program's process: {exc}"
+            "the station or the parameters cannot be passed to the program's process: "
+            + _short(str(exc))
         ) from None
-    (job / _REQUEST).write_bytes(data)
+    try:
+        (job / _REQUEST).write_bytes(data)
+    except OSError as exc:
+        raise UsageError(f"cannot write olp's temporary files in {job}: {exc.strerror}") from None
 
 
 def _run(job: Path, timeout: float | None) -> int | None:
@@ -173,12 +180,17 @@ def _run(job: Path, timeout: float | None) -> int | None:
     env["PYTHONPATH"] = os.pathsep.join(p for p in (here, env.get("PYTHONPATH")) if p)
     env.setdefault("PYTHONHASHSEED", "0")
     posix = os.name == "posix"
-    child = subprocess.Popen(
-        [sys.executable, "-c", _BOOT, str(job)],
-        stdin=subprocess.DEVNULL,
-        env=env,
-        start_new_session=posix,
-    )
+    try:
+        child = subprocess.Popen(
+            [sys.executable, "-c", _BOOT, str(job)],
+            stdin=subprocess.DEVNULL,
+            env=env,
+            start_new_session=posix,
+        )
+    except (OSError, ValueError) as exc:
+        raise UsageError(
+            f"cannot start a Python process ({sys.executable!r}) to run the program: {exc}"
+        ) from None
     if not posix:
         return _run_elsewhere(child, timeout)
     watchdog = _Watchdog(child.pid, job, timeout)
@@ -391,6 +403,7 @@ def child_main(folder: str) -> None:
     real_exit = os._exit
     request = pickle.loads((job / _REQUEST).read_bytes())
     filename = request["filename"]
+    sys.argv = [filename]
     dumps = _arm_faulthandler(job)
     _watch_exit(job, filename, real_exit)
     payload = _run_program(request)

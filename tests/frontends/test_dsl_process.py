@@ -189,13 +189,20 @@ def test_a_program_that_records_nothing_is_an_error(tmp_path: Path) -> None:
 # What travels between the processes
 
 
-IN_CHILD = "if sys.argv[0] == '-c' and pathlib.Path(sys.argv[1], 'request').exists():\n"
-"""Only in olp's child process (its argv is ``-c FOLDER``) does a test program write there."""
+IN_CHILD = (
+    "f = sys._getframe()\n"
+    "while f is not None and not isinstance(f.f_locals.get('job'), pathlib.Path):\n"
+    "    f = f.f_back\n"
+    "if f is not None and (f.f_locals['job'] / 'request').exists():\n"
+    "    folder = f.f_locals['job']\n"
+)
+"""Only in olp's child process (its entry point holds the ``job`` folder) does a test program
+write into that folder."""
 
 
 def test_the_parent_survives_garbage_in_the_result(tmp_path: Path) -> None:
     text = (
-        HOME + "import os, sys, pathlib\n" + IN_CHILD + "    pathlib.Path(sys.argv[1], "
+        HOME + "import os, sys, pathlib\n" + IN_CHILD + "    pathlib.Path(folder, "
         "'result').write_bytes(b'not a pickle')\n"
         "    os._exit(0)\n"
     )
@@ -211,7 +218,7 @@ def test_the_result_cannot_run_code_in_olp(tmp_path: Path) -> None:
         "class Evil:\n"
         "    def __reduce__(self):\n"
         f"        return (os.system, ('touch {marker}',))\n" + IN_CHILD + "    pathlib.Path("
-        "sys.argv[1], 'result').write_bytes(pickle.dumps(('ok', Evil())))\n"
+        "folder, 'result').write_bytes(pickle.dumps(('ok', Evil())))\n"
         "    os._exit(0)\n"
     )
     error = child_error(program(tmp_path, text))
@@ -255,6 +262,12 @@ def test_a_program_built_in_the_child_writes_the_same_robot_code(station: Statio
     inside = build(station, run_dsl(path.read_bytes(), str(path), station).program)
     child = build(station, path)
     assert child.ok and child.files == inside.files
+
+
+def test_the_program_sees_argv_as_a_script_would(tmp_path: Path) -> None:
+    path = program(tmp_path, HOME + "import sys\nrobot.RunInstruction(repr(sys.argv), 3)\n")
+    comment = load_dsl(path).program.instructions[-1]
+    assert isinstance(comment, ir.Comment) and comment.text == repr([str(path)])
 
 
 def test_the_programs_output_reaches_the_user(

@@ -73,6 +73,43 @@ def test_rows_that_do_not_match_the_header_are_errors(
     assert error.hint is not None and "header" in error.hint
 
 
+MISNAMED = [
+    # a header whose names say the file means something else: column, message
+    ("x,y,z,rz\n1,2,3,4\n", 7, "the header names 'rz' (an angle) where olp reads a speed"),
+    ("y,x,z\n1,2,3\n", 1, "names 'y' (the y coordinate) where olp reads the x coordinate"),
+    ("a1,a2,a3,a4,a5,a6\n0,-90,90,0,0,0\n", 1, "names 'a1' (an angle) where olp reads the x"),
+    ("x,y,z,i,j,k\n1,2,3,0,0,1\n", 7, "'i' (a tool direction vector component)"),
+    ("x,y,z,qw,qx,qy,qz\n1,2,3,1,0,0,0\n", 7, "'qw' (a quaternion component)"),
+    ("J1;J2;J3;J4;J5;J6\n0;-90;90;0;0;0\n", 1, "'J1' (a joint value)"),
+    ("X [mm], Y [mm], Z [mm], ID\n1,2,3,4\n", 25, "'ID' (an index) where olp reads a speed"),
+]
+
+
+@pytest.mark.parametrize(("text", "column", "message"), MISNAMED)
+def test_a_header_that_names_other_columns_is_an_error(
+    text: str, column: int, message: str
+) -> None:
+    error = error_of(text, CsvOptions())
+    assert error.span is not None and (error.span.line, error.span.column) == (1, column)
+    assert message in error.message
+    assert error.hint is not None and "reorder the columns" in error.hint
+
+
+WELL_NAMED = [
+    ("X [mm],Y [mm],Z [mm],F [mm/min]\n1,2,3,4\n", ("x", "y", "z", "speed")),
+    ("x y z speed\n1 2 3 4\n", ("x", "y", "z", "speed")),
+    ("X,Y,Z,W,P,R,ID\n1,2,3,4,5,6,7\n", ("x", "y", "z", "a1", "a2", "a3", "index")),
+    ("x_mm;y_mm;z_mm;a;b;c\n1;2;3;4;5;6\n", ("x", "y", "z", "a1", "a2", "a3")),
+    ("Pos X,Pos Y,Pos Z\n1,2,3\n", ("x", "y", "z")),
+]
+
+
+@pytest.mark.parametrize(("text", "columns"), WELL_NAMED)
+def test_headers_that_name_olps_columns_are_read(text: str, columns: tuple[str, ...]) -> None:
+    options = CsvOptions() if len(columns) >= 6 else DOWN
+    assert parse_csv(text, "t.csv", options).layout.columns == columns
+
+
 def test_a_title_row_above_the_data_is_not_a_header_of_columns() -> None:
     result = parse_csv("Toolpath\n1,2,3\n4,5,6\n", "t.csv", DOWN)
     assert len(result.program) == 2 and result.layout.columns == ("x", "y", "z")
