@@ -8,7 +8,7 @@ end is reported honestly, as an :class:`~olp.errors.OlpError` at the program's f
 
 * the program finished: its :class:`~olp.frontends.dsl.DslResult` (or the located error of
   its own exception) comes back as a pickle in a private temporary folder, read by an
-  unpickler that builds only olp IR objects, numpy arrays and plain data; anything else
+  unpickler that builds only olp data classes, numpy arrays and plain data; anything else
   (garbage, an object of the program's own class) is an error, never a crash of olp;
 * it ran longer than ``timeout`` seconds: the child and every process it started are killed;
   the error names the line it was running (a :mod:`faulthandler` stack dump on ``SIGUSR1``);
@@ -36,6 +36,7 @@ run.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import math
 import os
 import pickle
@@ -376,13 +377,14 @@ def _plain(module: str, name: str) -> bool:
 
 
 class _Unpickler(pickle.Unpickler):
-    """Builds only olp IR and result classes, numpy arrays and plain data: the result file is
-    written by a process that ran the user's code, so nothing else may come out of it."""
+    """Builds only olp's data classes (the IR, the result), numpy arrays and plain data: the
+    result file is written by a process that ran the user's code, so nothing else (no function
+    call, no other class) may come out of it."""
 
     def find_class(self, module: str, name: str) -> Any:
-        if module in ("olp.ir", "olp.frontends.dsl"):
+        if module == "olp" or module.startswith("olp."):
             found = super().find_class(module, name)
-            if isinstance(found, type):
+            if isinstance(found, type) and dataclasses.is_dataclass(found):
                 return found
         elif (module, name) in _NUMPY or _plain(module, name):
             return super().find_class(module, name)
