@@ -14,14 +14,15 @@ Parameters come from the command line (``--set SPEED=50``) and are read with
 text; without a default an int, else a float, else the text). A ``--set`` name the program
 never asks for is a :class:`~olp.errors.UsageError` (a typo must not pass silently).
 
-Errors: a syntax error, a wrong DSL call or any exception raised by the program becomes a
-:class:`~olp.errors.ParseError` at the user's line (the innermost traceback frame in the
-program file) with the line's text and a caret under the failing expression, never a
-traceback dump; when the exception passed through several of the user's own frames, the hint
-lists them (olp's and libraries' frames left out). ``sys.exit()`` / ``SystemExit(0)`` ends the
-program normally; a program that records no instruction at all is an error (an empty robot
-program is never what was meant). Messages quote at most a short excerpt of the program's
-text and values.
+Errors: a syntax error or a wrong DSL call is a :class:`~olp.errors.ParseError`, any other
+exception raised by the program a :class:`~olp.frontends.dsl_process.ProgramRunError` (a
+ParseError printed as "error running the program"), each at the user's line (the innermost
+traceback frame in the program file) with the line's text and a caret under the failing
+expression, never a traceback dump; when the exception passed through several of the user's
+own frames, the hint lists them (olp's and libraries' frames left out). ``sys.exit()`` /
+``SystemExit(0)`` ends the program normally; a program that records no instruction at all is
+an error (an empty robot program is never what was meant). Messages quote at most a short
+excerpt of the program's text and values.
 """
 
 from __future__ import annotations
