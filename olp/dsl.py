@@ -11,8 +11,10 @@ optional and only helps editors)::
     for i in range(7):
         robot.MoveL(ref * rotz(i * 2 * pi / 6) * transl(50, 0, 0))
 
-**A DSL program runs with the full privileges of Python**, like any script you run: it can read
-and write files, import modules and so on. Only run programs you trust.
+**A DSL program is code that olp runs, with the full privileges of Python and your rights**,
+like any script you run: it can read and write files, import modules and so on. Only run
+programs you trust. olp runs it in a child process stopped after ``--timeout`` seconds
+(:mod:`olp.frontends.dsl_process`), so how it ends is reported, but that is no sandbox.
 
 Units and conventions (those of the RoboDK API, whose names robot programmers know)
 -----------------------------------------------------------------------------------
