@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Protocol
 
 from olp.diagnostics import Diagnostic, has_errors
 from olp.errors import UsageError
+from olp.frontends.dsl_process import DEFAULT_TIMEOUT as DSL_TIMEOUT
 from olp.ir import Program, SourceSpan
 from olp.passes.collide import CollisionOptions
 from olp.passes.resolve import CompiledProgram, ResolveOptions, resolve
@@ -46,9 +47,12 @@ def parse(
     params: Mapping[str, object] | None = None,
     csv_options: CsvOptions | None = None,
     krl_config_dat: str | Path | None = None,
+    timeout: float | None = DSL_TIMEOUT,
 ) -> ParsedProgram:
     """Read a program file; the frontend is chosen by suffix (see :data:`FRONTENDS`).
 
+    A ``.py`` program is code: it runs (with the caller's rights) in a child process, killed
+    after ``timeout`` seconds (None: no limit); see :mod:`olp.frontends.dsl_process`.
     ``station``: what CSV and Python programs may consult (tools and frames by name, the home
     position, feasibility questions); ``params``: ``--set`` values for a Python program;
     ``csv_options``: how to read a CSV toolpath; ``krl_config_dat``: the controller's
@@ -67,7 +71,7 @@ def parse(
         raise UsageError(f"CSV options are for .csv toolpaths, not {suffix} files")
     if krl_config_dat is not None and suffix != ".src":
         raise UsageError(f"--config-dat is for KRL .src programs, not {suffix} files")
-    context = _ParseContext(station, params or {}, csv_options, krl_config_dat)
+    context = _ParseContext(station, params or {}, csv_options, krl_config_dat, timeout)
     return frontend(path, context)
 
 
@@ -77,6 +81,7 @@ class _ParseContext:
     params: Mapping[str, object]
     csv_options: CsvOptions | None
     krl_config_dat: str | Path | None = None
+    timeout: float | None = DSL_TIMEOUT
 
 
 def _parse_krl(path: Path, context: _ParseContext) -> ParsedProgram:
@@ -99,7 +104,7 @@ def _parse_csv(path: Path, context: _ParseContext) -> ParsedProgram:
 def _parse_dsl(path: Path, context: _ParseContext) -> ParsedProgram:
     from olp.frontends.dsl import load_dsl
 
-    result = load_dsl(path, context.station, context.params)
+    result = load_dsl(path, context.station, context.params, timeout=context.timeout)
     warnings = tuple(
         Diagnostic("warning", "program", item.message, item.span) for item in result.warnings
     )
@@ -186,11 +191,13 @@ def build(
     csv_options: CsvOptions | None = None,
     krl_config_dat: str | Path | None = None,
     collisions: CollisionOptions | None = _DEFAULT_COLLISIONS,
+    timeout: float | None = DSL_TIMEOUT,
 ) -> BuildResult:
     """Compile ``program`` on ``station`` and render it through ``post``.
 
-    ``options`` set the checks (e.g. ``ResolveOptions(skip_unreachable=True)``); ``params``
-    and ``csv_options`` go to :func:`parse` when ``program`` is a file. Files are written to
+    ``options`` set the checks (e.g. ``ResolveOptions(skip_unreachable=True)``); ``params``,
+    ``csv_options`` and ``timeout`` (seconds a ``.py`` program may run) go to :func:`parse`
+    when ``program`` is a file. Files are written to
     ``out_dir`` (if given) only when no error diagnostic remains.
     """
     from olp.posts import find_post
@@ -211,6 +218,7 @@ def build(
             params=params,
             csv_options=csv_options,
             krl_config_dat=krl_config_dat,
+            timeout=timeout,
         )
         program, notes = parsed.program, parsed.notes
     writer = post if isinstance(post, Post) else find_post(post)

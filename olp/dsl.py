@@ -11,8 +11,10 @@ optional and only helps editors)::
     for i in range(7):
         robot.MoveL(ref * rotz(i * 2 * pi / 6) * transl(50, 0, 0))
 
-**A DSL program runs with the full privileges of Python**, like any script you run: it can read
-and write files, import modules and so on. Only run programs you trust.
+**A DSL program is code that olp runs, with the full privileges of Python and your rights**,
+like any script you run: it can read and write files, import modules and so on. Only run
+programs you trust. olp runs it in a child process stopped after ``--timeout`` seconds
+(:mod:`olp.frontends.dsl_process`), so how it ends is reported, but that is no sandbox.
 
 Units and conventions (those of the RoboDK API, whose names robot programmers know)
 -----------------------------------------------------------------------------------
@@ -108,6 +110,27 @@ __all__ = [
 
 class DslError(Exception):
     """A DSL call was used wrongly; the frontend reports it at the user's line."""
+
+
+EXCERPT_CHARS = 60
+"""Longest piece of the program's text or values a message quotes (the rest is summarised by
+its length): a 20 MB string must not become a 20 MB message."""
+MAX_IO = 2**31 - 1
+"""Largest I/O number a program may use (a controller's integer; vendors allow fewer)."""
+
+
+def quote(text: str) -> str:
+    """``text`` quoted for a message, cut to :data:`EXCERPT_CHARS` characters."""
+    if len(text) <= EXCERPT_CHARS:
+        return repr(text)
+    return f"{text[:EXCERPT_CHARS]!r}... ({len(text)} characters)"
+
+
+def names_list(names: Sequence[str], limit: int = 10) -> str:
+    """Known names for a message: at most ``limit``, each shortened."""
+    shown = [quote(n) if len(n) > EXCERPT_CHARS else n for n in names[:limit]]
+    more = f", ... ({len(names) - limit} more)" if len(names) > limit else ""
+    return ", ".join(shown) + more
 
 
 # ------------------------------------------------------------------------------------------------
@@ -287,12 +310,25 @@ def rotz(rz: float) -> Mat:
 def transl(tx: float | Sequence[float], ty: float | None = None, tz: float | None = None) -> Mat:
     """A translation in mm: ``transl(x, y, z)`` or ``transl([x, y, z])``."""
     if ty is None and tz is None and not isinstance(tx, int | float):
-        values = _finite(list(tx)[:3], "transl")
+        values = _finite(_sequence(tx, "transl"), "transl")
+        if len(values) != 3:
+            raise DslError(f"transl: expected [x, y, z] in mm, got {len(values)} values")
     else:
         values = _finite([tx, ty, tz], "transl")  # type: ignore[list-item]
     m = np.eye(4)
     m[:3, 3] = values
     return Mat(m)
+
+
+def _sequence(values: Any, what: str) -> list[Any]:
+    if isinstance(values, str | bytes | Mapping) or not hasattr(values, "__iter__"):
+        raise DslError(f"{what}: expected a list of numbers, got {_describe(values)}")
+    items = []
+    for item in values:
+        items.append(item)
+        if len(items) > 16:
+            break
+    return items
 
 
 def eye(size: int = 4) -> Mat:
@@ -345,8 +381,17 @@ def _mat(value: Any, what: str) -> Mat:
 
 
 def _describe(value: Any) -> str:
-    text = repr(value)
-    return f"{type(value).__name__} {text[:60]}{'...' if len(text) > 60 else ''}"
+    """The type and a shortened repr of a value the program passed, for a message."""
+    return f"{type(value).__name__[:EXCERPT_CHARS]} {brief(value)}"
+
+
+def brief(value: Any) -> str:
+    """A value's repr for a message, cut to :data:`EXCERPT_CHARS` characters."""
+    try:
+        text = repr(value)
+    except Exception:
+        text = "(no repr)"
+    return f"{text[:EXCERPT_CHARS]}..." if len(text) > EXCERPT_CHARS else text
 
 
 # ------------------------------------------------------------------------------------------------
@@ -366,12 +411,12 @@ class Target:
 
     def Pose(self) -> Mat:
         if self.pose is None:
-            raise DslError(f"target {self.name!r} is a joint target; it has no pose")
+            raise DslError(f"target {quote(self.name)} is a joint target; it has no pose")
         return self.pose.copy()
 
     def Joints(self) -> list[float]:
         if self.joints is None:
-            raise DslError(f"target {self.name!r} is a Cartesian target; ask robot.SolveIK")
+            raise DslError(f"target {quote(self.name)} is a Cartesian target; ask robot.SolveIK")
         return list(self.joints)
 
     def isJointTarget(self) -> bool:
@@ -464,7 +509,9 @@ def _session() -> Session:
 # The robot: motions, settings and questions to the station
 
 
-_CALL = re.compile(r"\s*([A-Za-z_][A-Za-z0-9_]*)\s*(?:\((.*)\))?\s*;?\s*")
+_CALL = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)(?:\s*\((.*)\))?")
+"""A program call once stripped of spaces and a final ``;``. One repeat between fixed
+characters: linear in the text (``\\s*;?\\s*`` backtracks cubically on a long run of spaces)."""
 
 
 class Robot:
@@ -532,9 +579,9 @@ class Robot:
             return self._s.targets[name]
         if name == "home":
             return Target("home", joints=self.JointsHome())
-        known = ", ".join(["home", *self._s.targets])
+        known = names_list(["home", *self._s.targets])
         raise DslError(
-            f"{what}: no target named {name!r} (known: {known}); define it with AddTarget"
+            f"{what}: no target named {quote(name)} (known: {known}); define it with AddTarget"
         )
 
     def _pose(self, pose: Mat | None, what: str, name: str | None) -> ir.CartesianTarget:
@@ -667,8 +714,8 @@ class Robot:
             return ir.Tool(name=name) if kind == "tool" else ir.Frame(name=name)
         table: Mapping[str, Any] = station.tools if kind == "tool" else station.frames
         if name not in table:
-            known = ", ".join([*builtin, *table])
-            raise DslError(f"the station has no {kind} named {name!r} (known: {known})")
+            known = names_list([*builtin, *table])
+            raise DslError(f"the station has no {kind} named {quote(name)} (known: {known})")
         return table[name]
 
     def _rigid(self, pose: Any, what: str) -> FloatArray:
@@ -682,13 +729,17 @@ class Robot:
     def _tool_pose(self) -> FloatArray:
         pose = self._tool.pose
         if pose is None:
-            raise DslError(f"tool {self._tool.name!r} is only known by name (run with a station)")
+            raise DslError(
+                f"tool {quote(self._tool.name)} is only known by name (run with a station)"
+            )
         return pose
 
     def _frame_pose(self) -> FloatArray:
         pose = self._frame.pose
         if pose is None:
-            raise DslError(f"frame {self._frame.name!r} is only known by name (run with a station)")
+            raise DslError(
+                f"frame {quote(self._frame.name)} is only known by name (run with a station)"
+            )
         return pose
 
     # ---- I/O, waits, calls, comments
@@ -739,13 +790,14 @@ class Robot:
             return
         if run_type != INSTRUCTION_CALL_PROGRAM:
             raise DslError(
-                f"RunInstruction: run type {run_type!r} is not supported (olp records program "
+                f"RunInstruction: run type {brief(run_type)} is not supported (olp records "
+                "program "
                 "calls and comments; raw code is vendor-specific)"
             )
-        match = _CALL.fullmatch(code)
+        match = _CALL.fullmatch(code.strip().removesuffix(";").rstrip())
         if match is None:
             raise DslError(
-                f"RunInstruction: {code!r} is not a program call like Name or Name(1, 2)"
+                f"RunInstruction: {quote(code)} is not a program call like Name or Name(1, 2)"
             )
         name, args = match.group(1), match.group(2)
         values = tuple(a.strip() for a in args.split(",")) if args and args.strip() else ()
@@ -892,21 +944,30 @@ def _array(value: Any) -> FloatArray | None:
 
 
 def _io_index(io_var: Any, what: str) -> int:
-    text = str(io_var).strip()
-    if isinstance(io_var, bool) or not text.isdigit() or int(text) < 1:
-        raise DslError(f"{what}: expected an I/O number >= 1, got {io_var!r}")
-    return int(text)
+    """An I/O number from 1 to :data:`MAX_IO`: an integer or its digits as text."""
+    number: int | None = None
+    if isinstance(io_var, int | np.integer) and not isinstance(io_var, bool):
+        number = int(io_var)
+    elif isinstance(io_var, str) and io_var.strip().isdigit() and len(io_var.strip()) <= 10:
+        number = int(io_var.strip())
+    if number is None or not 1 <= number <= MAX_IO:
+        raise DslError(
+            f"{what}: expected an I/O number from 1 to {MAX_IO}, got {_describe(io_var)}"
+        )
+    return number
 
 
 def _io_value(value: Any, what: str) -> bool:
-    text = str(value).strip().lower()
-    if isinstance(value, bool):
-        return value
+    if isinstance(value, bool | np.bool_):
+        return bool(value)
+    if isinstance(value, int | float | np.number) and value in (0, 1):
+        return bool(value == 1)
+    text = value.strip().lower() if isinstance(value, str) else ""
     if text in TRUE_WORDS or text == "1.0":
         return True
     if text in FALSE_WORDS or text == "0.0":
         return False
-    raise DslError(f"{what}: expected 1/0, True/False or on/off, got {value!r}")
+    raise DslError(f"{what}: expected 1/0, True/False or on/off, got {_describe(value)}")
 
 
 # ------------------------------------------------------------------------------------------------
@@ -987,7 +1048,12 @@ def param(name: str, default: object = None) -> Any:
 
 def warn(message: str) -> None:
     """Report ``message`` as a warning at this line of the program (e.g. a skipped target)."""
-    _session().warn(str(message))
+    _session().warn(_warning_text(message))
+
+
+def _warning_text(message: object, limit: int = 500) -> str:
+    text = str(message)
+    return text if len(text) <= limit else f"{text[:limit]}... ({len(text)} characters)"
 
 
 def AddTarget(name: str, value: Any) -> Target:
@@ -996,7 +1062,7 @@ def AddTarget(name: str, value: Any) -> Target:
     if not isinstance(name, str) or not name:
         raise DslError(f"AddTarget: expected a name, got {_describe(name)}")
     if name in session.targets or name == "home":
-        raise DslError(f"AddTarget: a target named {name!r} exists already")
+        raise DslError(f"AddTarget: a target named {quote(name)} exists already")
     if isinstance(value, Mat):
         target = Target(name, pose=value)
     else:

@@ -34,12 +34,16 @@ _CSV_OPTIONS = (
     "speed",
     "zone",
 )
+PROGRAM_HELP = (
+    "program file: .src KRL, .csv toolpath, or .py Python program. A .py program is code "
+    "that olp runs, with your rights (in a child process, stopped after --timeout)"
+)
 _DELIMITER_NAMES = {"tab": "\t", "\\t": "\t", "space": " ", "comma": ",", "semicolon": ";"}
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("station", help="station YAML file")
-    parser.add_argument("program", help="program file (.src KRL, .csv toolpath, .py program)")
+    parser.add_argument("program", help=PROGRAM_HELP)
     parser.add_argument("--post", default="kuka", help="post name or folder (default: kuka)")
     parser.add_argument("-o", "--out", default="out", help="output folder (default: out)")
     parser.add_argument("--name", help="program name in the output (default: from the source)")
@@ -59,6 +63,13 @@ def add_program_options(parser: argparse.ArgumentParser) -> None:
         default=[],
         metavar="NAME=VALUE",
         help="a parameter of a Python program (repeatable), read with param('NAME', default)",
+    )
+    parser.add_argument(
+        "--timeout",
+        type=float,
+        default=60.0,
+        metavar="SECONDS",
+        help="stop a .py program that runs longer than this (default: 60)",
     )
     parser.add_argument(
         "--config-dat",
@@ -152,6 +163,7 @@ def run(args: argparse.Namespace) -> int:
         csv_options=csv_options(args),
         krl_config_dat=args.config_dat,
         collisions=collision_options(args),
+        timeout=args.timeout,
     )
     print_diagnostics(result.diagnostics, args.program, quiet=args.quiet)
     write_outputs(args, result)

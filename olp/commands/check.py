@@ -28,14 +28,14 @@ HELP = "check a program on a station (reach, limits, singularities) without writ
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("station", help="station YAML file")
-    parser.add_argument("program", help="program file")
+    from olp.commands.build import PROGRAM_HELP, add_program_options
+
+    parser.add_argument("program", help=PROGRAM_HELP)
     add_check_options(parser)
     add_collision_options(parser)
     parser.add_argument("--report", help="write a JSON report to this file")
     parser.add_argument("--sarif", help="write the diagnostics as SARIF 2.1.0 to this file")
     parser.add_argument("-q", "--quiet", action="store_true", help="print errors only")
-    from olp.commands.build import add_program_options
-
     add_program_options(parser)
 
 

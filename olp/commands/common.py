@@ -66,4 +66,5 @@ def parse_program(args: argparse.Namespace, station: Station) -> ParsedProgram:
         params=program_params(args),
         csv_options=csv_options(args),
         krl_config_dat=args.config_dat,
+        timeout=args.timeout,
     )

@@ -44,7 +44,9 @@ OVERRIDABLE = ("set_output", "wait_input", "call", "comment")
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("station", help="station YAML file")
-    parser.add_argument("program", help="program file")
+    from olp.commands.build import PROGRAM_HELP
+
+    parser.add_argument("program", help=PROGRAM_HELP)
     parser.add_argument(
         "--sweep-linear",
         metavar="MM_S,...",

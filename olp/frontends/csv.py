@@ -38,6 +38,10 @@ or whitespace), a decimal comma (with a ``;``, tab or whitespace delimiter) and 
 detected or given. Units come from header cells such as ``x [mm]``, ``x (m)``, ``x_in``,
 ``a [rad]``, ``speed [mm/min]``; without any, mm, degrees and mm/s. A unit given in the options
 that contradicts the header is an error. Lines that are blank or start with ``#`` are skipped.
+The header row right above the data names the columns: a first data row with another number
+of cells, or a name olp knows over a column it reads as something else (``rz`` over the speed
+column, ``a1..a6`` or ``j1..j6`` joint values, ``i, j, k`` tool vectors, quaternions, ``y``
+first), is an error rather than a file read another way. A one-cell row above is a title.
 
 The file is read in blocks of :attr:`CsvOptions.chunk_bytes` and each block is parsed by numpy
 in one call, so memory stays bounded by the block size plus the arrays the result needs
@@ -87,10 +91,18 @@ ANGLE_UNITS = {"deg": math.pi / 180.0, "rad": 1.0}
 EULER_ALIASES = {"wpr": "xyz", "abc": "ZYX"}
 
 _DELIMITERS: tuple[str | None, ...] = (",", ";", "\t", "|", None)
-_NUMBER = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
+# Both patterns are linear in the text: no two adjacent repeats can match the same characters
+# (``[0-9]+\.?[0-9]*`` or ``\s*[)]?\s*`` backtrack quadratically on a long cell).
+_NUMBER = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 _UNIT = re.compile(
-    r"(?:[\[(]\s*|_|\s)(mm|m|in|inch|deg|rad)(?:\s*/\s*(s|sec|min))?\s*[\])]?\s*$", re.IGNORECASE
+    r"(?:[\[(]\s*|_|\s)(mm|m|in|inch|deg|rad)(?:\s*/\s*(s|sec|min))?\s*(?:[\])]\s*)?$",
+    re.IGNORECASE,
 )
+EXCERPT_CHARS = 40
+"""Longest piece of a file's text a message quotes; the rest is summarised by its length."""
+MAX_INDEX = 2**53 - 1
+"""Largest index (in size) a 7-column row may give: every integer up to it survives the float
+the row is read as, so the target's name is the number in the file."""
 
 
 # ------------------------------------------------------------------------------------------------
@@ -414,10 +426,12 @@ class _Head:
         count = self._header_count(content)
         if count >= len(content):
             number, text = content[-1]
-            raise self._error("no data rows after the header rows", number, text)
+            raise self._error("no data rows after the header rows", number, text, _quote_hint(text))
         headers = content[:count]
         number, first = content[count]
         delimiter, decimal = self._separators(number, first, count)
+        if headers:
+            self._match_header(headers[-1], number, first, delimiter)
         cells = _split(first, delimiter)
         columns = LAYOUTS.get(len(cells))
         if columns is None:
@@ -426,6 +440,8 @@ class _Head:
                 "z and three angles) or 7 (x, y, z, three angles and an index)"
             )
             raise self._error(message, number, first)
+        if headers:
+            self._match_names(headers[-1], columns, delimiter)
         self.layout = self._layout(columns, delimiter, decimal, headers)
         self.ignored = tuple(
             IgnoredLine(ir.SourceSpan(filename, n, 1), text.strip(), "header row")
@@ -435,6 +451,47 @@ class _Head:
 
     def _error(self, message: str, line: int, text: str, hint: str | None = None) -> ParseError:
         return ParseError(message, ir.SourceSpan(self.filename, line, 1), text, hint)
+
+    def _match_header(
+        self, header: tuple[int, str], line: int, text: str, delimiter: str | None
+    ) -> None:
+        """The first data row has as many cells as the header row right above it, which names
+        the columns. A different count means the rows are not what the header says (``x,y,z``
+        over ``400,5,0,500`` must not become x, y, z and a speed). A one-cell row is a title."""
+        number, names = header
+        expected = len(_split(names.strip(), delimiter))
+        if expected > 1 and len(_split(text, delimiter)) != expected:
+            what = f"cells like the header row on line {number} ({_excerpt(names.strip())})"
+            hint = "make every row match the header; start a title row with '#'"
+            raise _count_error(text, line, delimiter, expected, what, self.filename, hint)
+
+    def _match_names(
+        self, header: tuple[int, str], columns: tuple[str, ...], delimiter: str | None
+    ) -> None:
+        """A header cell olp recognises names what olp reads in its column: ``speed`` over a
+        4th column, an angle over the 4th to 6th. ``x,y,z,rz`` over four numbers, ``a1..a6``
+        joint values or ``i,j,k`` tool vectors would otherwise be read as something else."""
+        number, text = header
+        spans = _cell_spans(text, delimiter)
+        if len(spans) != len(columns):
+            return
+        for (start, end), column in zip(spans, columns, strict=True):
+            kind = HEADER_NAMES.get(_base_name(text[start:end]))
+            expected = _COLUMN_KINDS[column]
+            if kind is None or kind == expected:
+                continue
+            cell = text[start:end].strip()
+            column_at = start + text[start:end].index(cell) + 1 if cell else start + 1
+            raise ParseError(
+                f"the header names {_excerpt(cell)} ({_KIND_TEXT[kind]}) where olp reads "
+                f"{_KIND_TEXT[expected]}: a row of {len(columns)} numbers is "
+                f"{', '.join(columns)}",
+                ir.SourceSpan(self.filename, number, column_at, number, column_at + len(cell)),
+                text,
+                "olp reads x, y, z (3 columns), then a speed (4), or three angles (6) and "
+                "an index (7): reorder the columns; joint values, tool vectors and "
+                "quaternions need converting",
+            )
 
     def _header_count(self, content: list[tuple[int, str]]) -> int:
         if self.options.header is not None:
@@ -575,6 +632,59 @@ class _HeaderUnits:
         self.units.setdefault(kind, (unit, cell))
 
 
+HEADER_NAMES: dict[str, str] = {
+    "x": "x",
+    "y": "y",
+    "z": "z",
+    **dict.fromkeys(("speed", "feed", "feedrate", "f", "v", "vel", "velocity"), "speed"),
+    **dict.fromkeys(
+        ("a", "b", "c", "w", "p", "r", "rx", "ry", "rz", "roll", "pitch", "yaw"), "angle"
+    ),
+    **dict.fromkeys(("alpha", "beta", "gamma", "a1", "a2", "a3"), "angle"),
+    **dict.fromkeys(("index", "idx", "id", "nr", "no", "number"), "index"),
+    **dict.fromkeys(("i", "j", "k", "nx", "ny", "nz", "vx", "vy", "vz"), "vector"),
+    **dict.fromkeys(("qw", "qx", "qy", "qz", "q0", "q1", "q2", "q3", "q4"), "quaternion"),
+    **dict.fromkeys(("a4", "a5", "a6", "j1", "j2", "j3", "j4", "j5", "j6"), "joint"),
+}
+"""Header cell names (without units, lower case) olp recognises, and what they name. A
+recognised name over a column olp reads as something else is an error."""
+_COLUMN_KINDS = {"x": "x", "y": "y", "z": "z", "speed": "speed", "index": "index"}
+_COLUMN_KINDS.update(dict.fromkeys(("a1", "a2", "a3"), "angle"))
+_KIND_TEXT = {
+    "x": "the x coordinate",
+    "y": "the y coordinate",
+    "z": "the z coordinate",
+    "speed": "a speed",
+    "angle": "an angle",
+    "index": "an index",
+    "vector": "a tool direction vector component",
+    "quaternion": "a quaternion component",
+    "joint": "a joint value",
+}
+
+
+def _base_name(cell: str) -> str:
+    """A header cell's name without its unit (``X [mm]`` -> ``x``), lower case."""
+    text = " " + cell.strip().strip("\"'")
+    match = _UNIT.search(text)
+    return (text[: match.start()] if match else text).strip().lower()
+
+
+def _quote_hint(text: str) -> str | None:
+    unquoted = text.replace('"', "").replace("'", "")
+    if unquoted != text and _has_number(unquoted):
+        return "olp reads plain numbers: remove the quotes around them"
+    return None
+
+
+def _excerpt(text: str) -> str:
+    """``text`` quoted for a message, cut to :data:`EXCERPT_CHARS` characters (a 20 MB row
+    must not become a 20 MB message)."""
+    if len(text) <= EXCERPT_CHARS:
+        return repr(text)
+    return f"{text[:EXCERPT_CHARS]!r}... ({len(text)} characters)"
+
+
 def _is_content(line: str) -> bool:
     stripped = line.strip()
     return bool(stripped) and not stripped.startswith("#")
@@ -695,16 +805,40 @@ def _check_row(text: str, line: int, layout: CsvLayout, filename: str) -> None:
     spans = _cell_spans(text, layout.delimiter)
     expected = len(layout.columns)
     if len(spans) != expected:
-        names = ", ".join(layout.columns)
-        raise ParseError(
-            f"expected {expected} columns ({names}), found {len(spans)}",
-            ir.SourceSpan(filename, line, 1, line, len(text) + 1),
-            text,
-        )
+        what = f"columns ({', '.join(layout.columns)})"
+        raise _count_error(text, line, layout.delimiter, expected, what, filename)
     for (start, end), column in zip(spans, layout.columns, strict=True):
         if not _is_number(text[start:end], layout.decimal):
             what = "an integer" if column == "index" else "a number"
             raise _cell_error(text, line, (start, end), filename, f"expected {what}", column)
+
+
+def _count_error(
+    text: str,
+    line: int,
+    delimiter: str | None,
+    expected: int,
+    what: str,
+    filename: str,
+    hint: str | None = None,
+) -> ParseError:
+    """A row with the wrong number of cells, pointing at the first extra cell or at the end of
+    the row where cells are missing."""
+    spans = _cell_spans(text, delimiter)
+    found = len(spans)
+    if found > expected:
+        start, end = spans[expected]
+        cell = text[start:end]
+        column = start + len(cell) - len(cell.lstrip()) + 1
+        detail = f"the first extra cell is {_excerpt(cell.strip())}"
+        width = max(len(cell.strip()), 1)
+        span = ir.SourceSpan(filename, line, column, line, column + width)
+    else:
+        column = len(text.rstrip()) + 1
+        missing = expected - found
+        detail = f"{missing} cell{'s' if missing > 1 else ''} missing at the end of the row"
+        span = ir.SourceSpan(filename, line, column)
+    return ParseError(f"expected {expected} {what}, found {found}: {detail}", span, text, hint)
 
 
 def _cell_error(
@@ -713,7 +847,7 @@ def _cell_error(
     raw = text[cell[0] : cell[1]]
     found = raw.strip()
     col = cell[0] + len(raw) - len(raw.lstrip()) + 1
-    shown = repr(found) if found else "nothing"
+    shown = _excerpt(found) if found else "nothing"
     return ParseError(
         f"column {column!r}: {expected}, found {shown}",
         ir.SourceSpan(filename, line, col, line, col + max(len(found), 1)),
@@ -732,8 +866,9 @@ def _check_values(chunk: CsvChunk, block: _Block, layout: CsvLayout, filename: s
             bad[:, col] |= ~(chunk.values[:, col] / layout.speed_divisor > 0)
             expected[col] = "a finite speed > 0"
         if "index" in layout.columns:
-            bad[:, -1] |= np.floor(chunk.values[:, -1]) != chunk.values[:, -1]
-            expected[-1] = "an integer"
+            index = chunk.values[:, -1]
+            bad[:, -1] |= (np.floor(index) != index) | (np.abs(index) > MAX_INDEX)
+            expected[-1] = f"an integer from -{MAX_INDEX} to {MAX_INDEX}"
     if not np.any(bad):
         return
     row, col = (int(v) for v in np.unravel_index(int(np.argmax(bad)), bad.shape))

@@ -1,24 +1,33 @@
 """Python DSL frontend: run a ``.py`` robot program and record what it asks the robot to do.
 
 The program is ordinary Python executed with the names of :mod:`olp.dsl` already defined
-(``robot``, ``transl``, ``Pose``, ``param``...). **It runs with full Python privileges**, like
-any script: only run programs you trust. Each call on ``robot`` records one IR instruction
-whose span is the user's call (file, line and column of the innermost frame in the program
-file), so every later diagnostic points at the user's line.
+(``robot``, ``transl``, ``Pose``, ``param``...). **A .py program is code that olp runs, with
+your rights**, like any script: only run programs you trust. :func:`load_dsl` (what ``olp
+build``, ``check`` and ``time`` use) runs it in a child process with a time limit and reports
+how it ended (:mod:`olp.frontends.dsl_process`); :func:`run_dsl` runs program text in the
+calling process, for the child and for callers who already trust the text. Each call on
+``robot`` records one IR instruction whose span is the user's call (file, line and column of
+the innermost frame in the program file), so every later diagnostic points at the user's line.
 
 Parameters come from the command line (``--set SPEED=50``) and are read with
 ``param("SPEED", default)``: text is converted to the type of the default (bool, int, float or
 text; without a default an int, else a float, else the text). A ``--set`` name the program
 never asks for is a :class:`~olp.errors.UsageError` (a typo must not pass silently).
 
-Errors: a syntax error, a wrong DSL call or any exception raised by the program becomes a
-:class:`~olp.errors.ParseError` at the user's line (the innermost traceback frame in the
-program file) with the line's text and a caret under the failing expression, never a
-traceback dump. ``sys.exit()`` / ``SystemExit(0)`` ends the program normally.
+Errors: a syntax error or a wrong DSL call is a :class:`~olp.errors.ParseError`, any other
+exception raised by the program a :class:`~olp.frontends.dsl_process.ProgramRunError` (a
+ParseError printed as "error running the program"), each at the user's line (the innermost
+traceback frame in the program file) with the line's text and a caret under the failing
+expression, never a traceback dump; when the exception passed through several of the user's
+own frames, the hint lists them (olp's and libraries' frames left out). ``sys.exit()`` /
+``SystemExit(0)`` ends the program normally; a program that records no instruction at all is
+an error (an empty robot program is never what was meant). Messages quote at most a short
+excerpt of the program's text and values.
 """
 
 from __future__ import annotations
 
+import linecache
 import math
 import os
 import sys
@@ -26,11 +35,18 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from importlib.util import decode_source
 from pathlib import Path
+from traceback import walk_tb
 from types import CodeType, FrameType, TracebackType
 from typing import TYPE_CHECKING, Any
 
 from olp import dsl, ir
 from olp.errors import OlpError, ParseError, UsageError
+from olp.frontends.dsl_process import (
+    DEFAULT_TIMEOUT,
+    ProgramRunError,
+    check_timeout,
+    run_in_child,
+)
 
 if TYPE_CHECKING:
     from olp.station.model import Station
@@ -68,22 +84,29 @@ def load_dsl(
     path: str | os.PathLike[str],
     station: Station | None = None,
     params: Mapping[str, object] | None = None,
+    *,
+    timeout: float | None = DEFAULT_TIMEOUT,
 ) -> DslResult:
-    """Run the DSL program at ``path`` and return what it recorded.
+    """Run the DSL program at ``path`` in a child process and return what it recorded.
 
     Parameters
     ----------
     path : a ``.py`` file (any encoding Python accepts: UTF-8 or a PEP 263 cookie).
     station : the station the program asks (home, named tools and frames, joint limits,
-        feasibility tests); without it those calls raise a located ParseError.
-    params : ``--set`` values by name (text from the command line, or Python values).
+        feasibility tests); without it those calls raise a located ParseError. The child gets
+        a copy of this very station.
+    params : ``--set`` values by name (text from the command line, or Python values that can
+        be pickled).
+    timeout : seconds the program may run (interpreter start included) before it is killed
+        and reported at the line it was running; None for no limit.
     """
+    check_timeout(timeout)
     filename = os.fspath(path)
     try:
         data = Path(path).read_bytes()
     except OSError as exc:
-        raise UsageError(f"cannot read program {filename!r}: {exc.strerror}") from None
-    return run_dsl(data, filename, station, params)
+        raise UsageError(f"cannot read program {dsl.quote(filename)}: {exc.strerror}") from None
+    return run_in_child(filename, data, station, params or {}, timeout)
 
 
 def run_dsl(
@@ -91,18 +114,32 @@ def run_dsl(
     filename: str = "<string>",
     station: Station | None = None,
     params: Mapping[str, object] | None = None,
+    *,
+    catch_interrupts: bool = False,
 ) -> DslResult:
-    """Run DSL program text (see :func:`load_dsl`); ``filename`` names it in spans."""
+    """Run DSL program text **in this process**, without a time limit (see :func:`load_dsl`
+    for untrusted files); ``filename`` names it in spans. ``catch_interrupts``: a
+    KeyboardInterrupt is the program's own exception (in the child, where Ctrl-C never
+    arrives) rather than the user stopping olp."""
     text = _decode(source, filename)
     code = _compile(text, filename)
     session = Session(filename, text, station, params)
     with dsl.active(session):
-        _execute(code, session)
+        _execute(code, session, catch_interrupts)
     unused = session.unused_params()
     if unused:
-        declared = ", ".join(session.declared) or "none"
+        declared = dsl.names_list(session.declared) or "none"
         raise UsageError(
-            f"--set {', '.join(unused)}: the program has no such parameter (it reads: {declared})"
+            f"--set {dsl.names_list(unused)}: the program has no such parameter "
+            f"(it reads: {declared})"
+        )
+    if not session.instructions:
+        raise ProgramRunError(
+            "the program recorded no robot instructions (no move, I/O, wait, call or comment)",
+            ir.SourceSpan(filename, 1, 1),
+            session.line_text(1),
+            "a program that ends early (sys.exit) or skips every move would write an empty "
+            "robot program",
         )
     return session.result()
 
@@ -153,16 +190,27 @@ def _syntax_error(exc: SyntaxError, text: str, filename: str) -> ParseError:
 # Running
 
 
-def _execute(code: CodeType, session: Session) -> None:
+def _execute(code: CodeType, session: Session, catch_interrupts: bool = False) -> None:
     try:
         exec(code, session.namespace())
     except SystemExit as exc:
         if exc.code not in (None, 0):
-            raise _located(exc, session, f"the program exited with {exc.code!r}") from exc
-    except (OlpError, KeyboardInterrupt):
+            shown = dsl.brief(exc.code)
+            raise _located(exc, session, f"the program exited with {shown}") from exc
+    except OlpError:
         raise
+    except KeyboardInterrupt as exc:
+        if not catch_interrupts:
+            raise
+        raise _located(exc, session, _message(exc)) from exc
     except BaseException as exc:
         raise _located(exc, session, _message(exc)) from exc
+
+
+MESSAGE_CHARS = 300
+"""Longest exception message of the program's that an error repeats."""
+TRACE_FRAMES = 8
+"""Most frames of the program's own traceback a hint lists (the innermost ones)."""
 
 
 def _message(exc: BaseException) -> str:
@@ -170,9 +218,12 @@ def _message(exc: BaseException) -> str:
         text = str(exc)
     except Exception:
         text = "(its message cannot be shown)"
+    if len(text) > MESSAGE_CHARS:
+        text = f"{text[:MESSAGE_CHARS]}... ({len(text)} characters)"
     if isinstance(exc, dsl.DslError):
         return text
-    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+    name = type(exc).__name__[: dsl.EXCERPT_CHARS]
+    return f"{name}: {text}" if text else name
 
 
 def _located(exc: BaseException, session: Session, message: str) -> ParseError:
@@ -182,8 +233,49 @@ def _located(exc: BaseException, session: Session, message: str) -> ParseError:
         span = ir.SourceSpan(session.filename, 1, 1)
     else:
         span = session.position(frame.tb_frame.f_code, frame.tb_lasti, frame.tb_lineno)
-    hint = None if isinstance(exc, dsl.DslError) else "raised while running the program"
-    return ParseError(message, span, session.line_text(span.line), hint)
+    trace = _user_trace(exc.__traceback__, session)
+    hint = f"the program's traceback (most recent call last):{trace}" if trace else None
+    # A wrong DSL call is the frontend refusing a statement (a parse error, as in KRL); any
+    # other exception is the program's own failure.
+    kind = ParseError if isinstance(exc, dsl.DslError) else ProgramRunError
+    return kind(message, span, session.line_text(span.line), hint)
+
+
+def _user_trace(tb: TracebackType | None, session: Session) -> str:
+    """The frames of ``tb`` in the user's own files (not olp's, not the standard library's or
+    installed packages'), one indented line each; empty when there are fewer than two."""
+    frames = [(f.f_code.co_filename, line, f.f_code.co_name) for f, line in walk_tb(tb)]
+    mine = [frame for frame in frames if _is_users(frame[0], session.filename)]
+    if len(mine) < 2:
+        return ""
+    lines = []
+    if len(mine) > TRACE_FRAMES:
+        lines.append(f"... {len(mine) - TRACE_FRAMES} frames left out")
+        mine = mine[-TRACE_FRAMES:]
+    for filename, line, name in mine:
+        text = session.line_text(line) if filename == session.filename else None
+        code = (text or linecache.getline(filename, line)).strip()
+        code = code if len(code) <= 80 else code[:80] + "..."
+        lines.append(f"{filename}:{line} in {name[:60]}: {code}")
+    return "".join("\n          " + line for line in lines)
+
+
+_PREFIXES = {sys.prefix, sys.base_prefix, sys.exec_prefix, sys.base_exec_prefix}
+_NOT_USERS = (*(Path(p).resolve() for p in _PREFIXES), Path(__file__).resolve().parents[1])
+"""Folders whose files are not the user's: Python's own (standard library, installed
+packages) and olp's."""
+
+
+def _is_users(filename: str, program: str) -> bool:
+    if filename == program:
+        return True
+    if filename.startswith("<"):
+        return False
+    try:
+        resolved = Path(filename).resolve()
+    except (OSError, ValueError):
+        return False
+    return not any(resolved.is_relative_to(folder) for folder in _NOT_USERS)
 
 
 def _innermost(tb: TracebackType | None, filename: str) -> TracebackType | None:

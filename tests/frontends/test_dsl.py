@@ -349,7 +349,7 @@ ERRORS = [
     ("robot.waitDI(1, 1, 500)\n", 1, 1, "a timeout is not supported"),
     ("robot.RunInstruction('x = 1', INSTRUCTION_INSERT_CODE)\n", 1, 1, "run type 1"),
     ("robot.RunInstruction('bad call(')\n", 1, 1, "is not a program call"),
-    ("robot.setDO(0, 1)\n", 1, 1, "expected an I/O number >= 1"),
+    ("robot.setDO(0, 1)\n", 1, 1, "expected an I/O number from 1 to 2147483647"),
     ("robot.setDO(1, 'maybe')\n", 1, 1, "expected 1/0, True/False or on/off"),
     ("robot.setPoseTool('torch')\n", 1, 1, "no tool named 'torch' (known: flange, spindle)"),
     ("p = Pose(0, 0, 0, 0, 0, 0).setPos([1, 2])\n", 1, 5, "setPos needs [x, y, z]"),
@@ -411,7 +411,7 @@ def test_unreadable_file_is_a_usage_error(tmp_path: Path) -> None:
 
 
 def test_program_warnings_are_recorded() -> None:
-    result = run("x = 3\nwarn(f'target {x} skipped')\n")
+    result = run("x = 3\nwarn(f'target {x} skipped')\nrobot.MoveJ([0, 0, 0, 0, 0, 0])\n")
     (warning,) = result.warnings
     assert warning.message == "target 3 skipped" and warning.span.line == 2
 
