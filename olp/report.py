@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from olp.api import BuildResult
-from olp.errors import line_of
+from olp.errors import excerpt, line_of
 from olp.ir import is_motion
 
 if TYPE_CHECKING:
@@ -195,6 +195,6 @@ def format_diagnostic(diagnostic: Any, sources: dict[str, str]) -> str:
     if line is None:
         return text
     head, _, rest = text.partition("\n")
-    caret = " " * max(span.column - 1, 0) + "^"
-    parts = [head, f"    {line.rstrip()}", f"    {caret}"]
+    shown, start, _ = excerpt(line.rstrip().expandtabs(1), max(span.column - 1, 0), 1)
+    parts = [head, f"    {shown}", "    " + " " * start + "^"]
     return "\n".join(parts + ([rest] if rest else []))

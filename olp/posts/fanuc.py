@@ -350,7 +350,7 @@ class FanucPost(Post):
     NAME_RULE = NAME_RULE
     COMMENTS = CommentRule(max_length=COMMENT_LENGTH, replace=((";", ","),), collapse=True)
     IO_RANGE = (1, 4096)
-    CALL_ARGUMENTS = ArgumentRule(re.compile(r"[+-]?(\d+\.?\d*|\.\d+)"), "numbers")
+    CALL_ARGUMENTS = ArgumentRule(re.compile(r"[+-]?(?:\d+(?:\.\d*)?|\.\d+)"), "numbers")
     NUMBERS: ClassVar[Mapping[str, NumberFormat]] = NUMBERS
     FILTERS: ClassVar[Mapping[str, Filter]] = FILTERS
 

@@ -121,8 +121,9 @@ class ArgumentRule:
         return self.pattern.fullmatch(str(argument).strip()) is not None
 
 
-NUMBER = r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
-"""A decimal number literal."""
+NUMBER = r"[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?"
+"""A decimal number literal (written so that matching is linear in its length: no two
+quantifiers may share the digits of a 200,000-digit argument)."""
 IDENTIFIER = r"[A-Za-z_][A-Za-z0-9_]*"
 """A plain name (a variable or constant of the program)."""
 

@@ -54,7 +54,7 @@ from numpy.typing import ArrayLike
 from olp.diagnostics import Diagnostic
 from olp.posts.base import Filter, Post
 from olp.posts.numbers import NumberFormat
-from olp.posts.text import ArgumentRule, CommentRule, NameRule
+from olp.posts.text import NUMBER, ArgumentRule, CommentRule, NameRule
 from olp.vendors.ur import pose_to_ur
 
 if TYPE_CHECKING:
@@ -98,7 +98,7 @@ NUMBERS: Mapping[str, NumberFormat] = {
 }
 """How the URScript post writes each quantity."""
 
-_LITERAL = re.compile(r'[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?|"[^"\\\x00-\x1f\x7f-\x9f]*"')
+_LITERAL = re.compile(NUMBER + r'|"[^"\\\x00-\x1f\x7f-\x9f]*"')
 
 
 # --------------------------------------------------------------------------------------------

@@ -201,6 +201,10 @@ ROWS: dict[str, Row] = {
         _after_ready(ir.Call(name="Grip", args=("1;MoveL p1",))),
         {post: Error("call_argument") for post in POSTS},
     ),
+    "call with a 200,000-digit argument (matched in linear time)": Row(
+        _after_ready(ir.Call(name="Grip", args=("9" * 200_000 + "x",))),
+        {post: Error("call_argument") for post in POSTS},
+    ),
     "call of an illegal name": Row(
         _after_ready(ir.Call(name="Spray On")),
         {post: Error("call_name") for post in POSTS},
