@@ -170,10 +170,15 @@ def _linear_run(
     instructions: tuple[Instruction, ...], start: int, station: Station
 ) -> list[tuple[LinearMove, Tool, Frame]]:
     """The consecutive linear moves from ``start`` to Cartesian targets with one resolvable tool
-    and resolvable frames, with their resolved tool and frames (empty if none start here)."""
+    and resolvable frames, with their resolved tool and frames (empty if none start here).
+
+    Walks the instructions by index: a slice ``instructions[start:]`` would copy the rest of
+    the program for every instruction that starts no run, which made resolve quadratic in
+    non-motion instructions (200,000 comments: 70 s)."""
     run: list[tuple[LinearMove, Tool, Frame]] = []
     first_tool: Tool | None = None
-    for ins in instructions[start:]:
+    for index in range(start, len(instructions)):
+        ins = instructions[index]
         if not (isinstance(ins, LinearMove) and isinstance(ins.target, CartesianTarget)):
             break
         tool = ins.tool if ins.tool.pose is not None else station.tool(ins.tool)
