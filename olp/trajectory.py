@@ -243,10 +243,15 @@ def sample_program(compiled: CompiledProgram, dt: float = 0.01) -> SampledTrajec
     if not compiled.ok or not compiled.steps:
         raise UsageError("the program has errors or no instructions: there is no trajectory")
     durations = np.array([step.duration for step in compiled.steps], dtype=np.float64)
-    starts = np.concatenate([[0.0], np.cumsum(durations)])
-    count = int(np.ceil(starts[-1] / dt - 1e-9)) + 1
-    if count > MAX_SAMPLES:
-        raise UsageError(f"dt {dt} s would give {count} samples: choose a larger step")
+    with np.errstate(over="ignore", invalid="ignore"):
+        starts = np.concatenate([[0.0], np.cumsum(durations)])
+        wanted = float(np.ceil(starts[-1] / dt - 1e-9)) + 1.0
+    if not wanted <= MAX_SAMPLES:  # also inf and NaN
+        raise UsageError(
+            f"dt {dt:g} s would give {wanted:.4g} samples of the {starts[-1]:.4g} s program "
+            f"(at most {MAX_SAMPLES}): choose a larger step"
+        )
+    count = int(wanted)
     t: FloatArray = np.arange(count, dtype=np.float64) * dt
     owner = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, durations.size - 1)
     bounds = np.searchsorted(owner, np.arange(durations.size + 1), side="left")

@@ -268,3 +268,16 @@ def test_report_start_times_match_the_sampled_trajectory(compiled: CompiledProgr
     assert report["path_length_m"] == pytest.approx(sum(lengths), abs=1e-8)
     tcp_travel = np.sum(np.linalg.norm(np.diff(sampled.tcp, axis=0), axis=-1))
     assert report["path_length_m"] == pytest.approx(tcp_travel, rel=2e-3)
+
+
+def test_a_program_too_long_to_sample_is_a_usage_error(compiled: CompiledProgram) -> None:
+    """A cycle time of inf (two waits of 1e308 s) raised OverflowError; a huge one printed a
+    66-digit sample count."""
+    import dataclasses
+
+    for duration, shown in ((np.inf, "inf samples"), (1e300, r"1e\+302 samples")):
+        steps = list(compiled.steps)
+        steps[1] = dataclasses.replace(steps[1], duration=duration)
+        huge = dataclasses.replace(compiled, steps=tuple(steps))
+        with pytest.raises(UsageError, match=shown):
+            sample_program(huge, dt=0.01)

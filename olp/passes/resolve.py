@@ -39,13 +39,15 @@ from olp.ir import (
     is_motion,
 )
 from olp.kinematics.base import turn_variants
-from olp.passes.sampling import SegmentSamples, sample_segments
+from olp.passes import wording
+from olp.passes.sampling import MAX_SAMPLES, SegmentSamples, sample_segments, segment_counts
 from olp.station.model import Robot, Station
 
 if TYPE_CHECKING:
     from olp.trajectory import Segment
 
 FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
 
 
 @dataclass(frozen=True, slots=True)
@@ -163,7 +165,15 @@ def _error(kind: str, message: str, index: int, ins: Instruction, **kw: object) 
 
 
 _RUN_CHUNK = 4096
-"""Linear moves resolved per vectorised batch (bounds memory on huge toolpaths)."""
+"""Most linear moves resolved per vectorised batch."""
+
+_RETRY_CHUNK = 16
+"""Moves in the batch after one that failed; the size doubles back to ``_RUN_CHUNK`` while
+batches succeed. A failure costs the samples of the moves after it in its batch, so a fixed
+size made a program of many failing moves quadratic (2,000 unreachable targets: 28 s)."""
+
+_BATCH_SAMPLES = MAX_SAMPLES
+"""Most TCP samples per batch (bounds memory: ~1 kB of temporaries per sample)."""
 
 
 def _linear_run(
@@ -196,66 +206,104 @@ def _resolve_linear_run(
     """Resolve consecutive linear moves in vectorised batches.
 
     The whole chain is sampled and solved at once in the branch it starts in. At the first
-    sample that fails (no solution, a joint limit, a joint jump), the moves before it are
-    accepted and the failing move is analysed alone by the per-move code, which words the
-    diagnostic exactly as for a single move (the same sampling rules apply); the batch then
-    goes on after it.
+    sample that fails (no solution, a joint limit, a joint jump), or at a move too long to
+    sample in a batch, the moves before it are accepted and the failing move is analysed alone
+    by the per-move code, which words the diagnostic exactly as for a single move (the same
+    sampling rules apply); the batch then goes on after it.
     """
     steps: list[Step] = []
     diags: list[Diagnostic] = []
-    k = 0
+    k, size = 0, _RUN_CHUNK
     while k < len(run):
-        chunk = run[k : k + _RUN_CHUNK]
-        path, ends, bad, samples = _batch_path(chunk, state)
-        good = len(chunk) if bad is None else bad
+        chunk = run[k : k + size]
+        batch = _batch_path(chunk, state)
+        good, samples = batch.good, batch.samples
         if good:
-            diags.extend(_speed_warnings(first + k, chunk[:good], path, samples, state.robot))
-        for m in range(good):
-            lo = 0 if m == 0 else int(ends[m - 1])
-            ins, tool, frame = chunk[m]
-            segment = path[lo : int(ends[m]) + 1]
-            steps.append(
-                Step(
-                    index=first + k + m,
-                    instruction=ins,
-                    joints=segment[-1],
-                    path=segment,
-                    tool=tool,
-                    frame=frame,
-                )
-            )
-        if good:
-            state.q = path[int(ends[good - 1])].copy()
-        if bad is not None:
-            step, found = _resolve_motion(first + k + bad, chunk[bad][0], station, state)
+            assert samples is not None
+            moves = chunk[:good]
+            diags.extend(_speed_warnings(first + k, moves, batch.path, samples, state.robot))
+            ends = samples.ends[:good] + 1
+            steps.extend(_batch_steps(first + k, moves, batch.path, ends))
+            state.q = batch.path[int(ends[-1])].copy()
+        if batch.bad is not None:
+            step, found = _resolve_motion(first + k + good, chunk[good][0], station, state)
             steps.append(step)
             diags.extend(found)
-        k += good + (0 if bad is None else 1)
+            size = _RETRY_CHUNK
+        elif good == len(chunk):
+            size = min(2 * size, _RUN_CHUNK)
+        k += good + (0 if batch.bad is None else 1)
     return steps, diags
 
 
-def _batch_path(
-    chunk: list[tuple[LinearMove, Tool, Frame]], state: _State
-) -> tuple[FloatArray, NDArray[np.int64], int | None, SegmentSamples]:
-    """Joint path (S + 1, 6) of a chain of linear moves from ``state.q`` (row 0), the row of
-    each move's end (M,), the index of the first move that fails (or None), and the samples."""
+def _batch_steps(
+    first: int, moves: list[tuple[LinearMove, Tool, Frame]], path: FloatArray, ends: IntArray
+) -> list[Step]:
+    """One step per move of a batch: its rows of the batch's joint path (S + 1, 6), from the
+    previous move's end row (``ends`` (M,): each move's last row)."""
+    steps = []
+    for m, (ins, tool, frame) in enumerate(moves):
+        segment = path[(0 if m == 0 else int(ends[m - 1])) : int(ends[m]) + 1]
+        steps.append(
+            Step(
+                index=first + m,
+                instruction=ins,
+                joints=segment[-1],
+                path=segment,
+                tool=tool,
+                frame=frame,
+            )
+        )
+    return steps
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class _Batch:
+    """A batch of linear moves sampled and solved: ``path`` (S + 1, 6) rad from the start
+    joints (row 0); ``samples`` of the moves sampled; ``good``: how many moves from the
+    first passed every check; ``bad``: the index of the move that failed or was too long to
+    sample (None: the first ``good`` moves are all the batch could take)."""
+
+    path: FloatArray
+    samples: SegmentSamples | None
+    good: int
+    bad: int | None
+
+
+def _batch_path(chunk: list[tuple[LinearMove, Tool, Frame]], state: _State) -> _Batch:
+    """Sample and solve a chain of linear moves from ``state.q``, as many as fit in
+    ``_BATCH_SAMPLES`` samples: a move that alone needs more than ``MAX_SAMPLES`` stops the
+    batch (the per-move code reports it; an absurd target never allocates its samples)."""
     robot, opts = state.robot, state.opts
     tool_pose = chunk[0][1].pose
     assert tool_pose is not None
     targets = np.stack([_world(frame) @ ins.target.pose for ins, _, frame in chunk])  # type: ignore[union-attr]
     start = robot.flange_poses(state.q) @ tool_pose
-    samples = sample_segments(start, targets, opts.step_m, opts.step_rad)
+    counts = segment_counts(start, targets, opts.step_m, opts.step_rad)
+    fit, too_long = _fitting(counts)
+    if fit == 0:
+        return _Batch(state.q[None], None, 0, 0)
+    samples = sample_segments(start, targets[:fit], opts.step_m, opts.step_rad)
     flanges = samples.poses @ inv(tool_pose)
     sols = robot.solve(flanges, seed=state.q)[:, robot.branch_of(state.q), :]
     path = np.vstack([state.q[None], _unwrap(state.q, sols)])
-    ends = samples.ends + 1
     with np.errstate(invalid="ignore"):
         invalid = ~np.all(np.isfinite(path[1:]), axis=-1)
         invalid |= np.any(robot.limits.violations(path[1:]), axis=-1)
         invalid |= np.any(np.abs(np.diff(path, axis=0)) > opts.max_joint_step_rad, axis=-1)
-    if not np.any(invalid):
-        return path, ends, None, samples
-    return path, ends, int(samples.segment[int(np.argmax(invalid))]), samples
+    if np.any(invalid):
+        bad = int(samples.segment[int(np.argmax(invalid))])
+        return _Batch(path, samples, bad, bad)
+    return _Batch(path, samples, fit, fit if too_long else None)
+
+
+def _fitting(counts: FloatArray) -> tuple[int, bool]:
+    """How many leading moves of sample counts ``counts`` (M,) fit in one batch, and whether
+    the next one (if any) needs more than ``MAX_SAMPLES`` by itself (NaN counts as that)."""
+    over = ~(counts <= MAX_SAMPLES)
+    total = np.cumsum(np.where(over, np.inf, counts))
+    fit = int(np.searchsorted(total, _BATCH_SAMPLES, side="right"))
+    return fit, fit < counts.size and bool(over[fit])
 
 
 def _speed_warnings(
@@ -280,10 +328,10 @@ def _speed_warnings(
     speeds = np.array([ins.speed.linear for ins, _, _ in moves])
     spacing = samples.lengths[:m] / counts
     dq = np.abs(np.diff(path[: rows + 1], axis=0))
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         needed = dq * (speeds / spacing)[segment][:, None]
-    needed[~np.isfinite(needed)] = 0.0
-    ratio = needed / robot.limits.velocity
+        needed[~np.isfinite(needed)] = 0.0
+        ratio = needed / robot.limits.velocity
     worst_per_move = np.maximum.reduceat(np.max(ratio, axis=1), samples.ends[:m] - counts + 1)
     over = worst_per_move > 1.0 + 1e-9
     out: list[Diagnostic] = []
@@ -293,13 +341,15 @@ def _speed_warnings(
         joint = int(np.argmax(ratio[row]))
         ins = moves[lo][0]
         where = f"move {first + lo}" if hi - lo == 1 else f"moves {first + lo}-{first + hi - 1}"
+        need, limit = wording.above(
+            float(np.degrees(needed[row, joint])), float(np.degrees(robot.limits.velocity[joint]))
+        )
         out.append(
             Diagnostic(
                 "warning",
                 "speed_limited",
-                f"{where}: {ins.speed.linear * 1000:.0f} mm/s needs axis {joint + 1} at "
-                f"{np.degrees(needed[row, joint]):.0f}°/s (limit "
-                f"{np.degrees(robot.limits.velocity[joint]):.0f}°/s); the TCP will be slower there",
+                f"{where}: {wording.quantity(ins.speed.linear * 1000, 0)} mm/s needs axis "
+                f"{joint + 1} at {need}°/s (limit {limit}°/s); the TCP will be slower there",
                 ins.span,
                 first + lo,
                 joints=path[row + 1],
@@ -434,14 +484,10 @@ def _joint_path(
 ) -> tuple[FloatArray | None, list[Diagnostic]]:
     robot = state.robot
     if isinstance(ins.target, JointTarget):
-        q = ins.target.joints
-        if q.shape != (robot.dof,):
-            msg = f"joint target has {q.size} values, the robot has {robot.dof} axes"
-            return None, [_error("bad_target", msg, index, ins)]
-        bad = robot.limits.violations(q)
-        if np.any(bad):
-            return None, [_limit_error(index, ins, robot, q, bad)]
-        return _joint_line(state.q, q), []
+        bad_target = _joint_target_error(index, ins, ins.target, robot)
+        if bad_target is not None:
+            return None, [bad_target]
+        return _joint_line(state.q, ins.target.joints), []
     flange = flange_target(ins.target, tool, frame)
     candidates = _candidates(robot, flange)
     if candidates.shape[0] == 0:
@@ -498,7 +544,8 @@ def _describe(config: Configuration) -> str:
     parts: list[str] = [v for v in (config.shoulder, config.elbow, config.wrist) if v is not None]
     if config.joint_ranges is not None:
         ranges = [
-            f"axis {i + 1} in [{np.degrees(r[0]):.0f}°, {np.degrees(r[1]):.0f}°)"
+            f"axis {i + 1} in [{wording.exact(float(np.degrees(r[0])))}°, "
+            f"{wording.exact(float(np.degrees(r[1])))}°)"
             for i, r in enumerate(config.joint_ranges)
             if r is not None and np.all(np.isfinite(r))
         ]
@@ -508,7 +555,8 @@ def _describe(config: Configuration) -> str:
 
 def _candidates(robot: Robot, flange: FloatArray) -> FloatArray:
     """Every IK solution within the joint limits, (K, 6), turn variants included."""
-    sols = robot.solve(flange[None])[0]
+    with np.errstate(over="ignore", invalid="ignore"):  # a target 1e308 m away has none
+        sols = robot.solve(flange[None])[0]
     variants = turn_variants(sols, robot.limits.lower, robot.limits.upper).reshape(-1, robot.dof)
     ok = np.all(np.isfinite(variants), axis=-1) & ~np.any(
         robot.limits.violations(variants), axis=-1
@@ -523,6 +571,9 @@ def _linear_path(
     assert tool.pose is not None
     start = robot.flange_poses(state.q)
     if isinstance(ins.target, JointTarget):
+        bad_target = _joint_target_error(index, ins, ins.target, robot)
+        if bad_target is not None:
+            return None, [bad_target]
         end = robot.flange_poses(ins.target.joints)
     else:
         end = flange_target(ins.target, tool, frame)
@@ -530,10 +581,13 @@ def _linear_path(
             return None, [_unreachable(index, ins, robot, end)]
     # Sample the TCP line, not the flange line: with a long tool they differ.
     tcp_start, tcp_end = start @ tool.pose, end @ tool.pose
-    dist, angle = pose_distance(tcp_start, tcp_end)
-    count = max(
-        int(np.ceil(dist / state.opts.step_m)), int(np.ceil(angle / state.opts.step_rad)), 1
+    count_f = float(
+        segment_counts(tcp_start, tcp_end[None], state.opts.step_m, state.opts.step_rad)[0]
     )
+    if not count_f <= MAX_SAMPLES:
+        return None, [_too_long(index, ins, tcp_start, tcp_end, count_f, state.opts)]
+    count = int(count_f)
+    dist = float(pose_distance(tcp_start, tcp_end)[0])
     fractions = np.linspace(0.0, 1.0, count + 1)
     flanges = interpolate_poses(tcp_start, tcp_end, fractions) @ inv(tool.pose)
     branch = robot.branch_of(state.q)
@@ -541,7 +595,8 @@ def _linear_path(
     if np.any(~np.isfinite(sols)):
         first = int(np.argmax(~np.all(np.isfinite(sols), axis=-1)))
         msg = (
-            f"the straight line leaves the robot's workspace at {fractions[first]:.0%} of the move"
+            f"the straight line leaves the robot's workspace at "
+            f"{wording.percent(fractions[first])} of the move"
             " (in the configuration the move starts in)"
         )
         return None, [_error("unreachable_path", msg, index, ins)]
@@ -556,12 +611,45 @@ def _linear_path(
         joint = int(np.argmax(jumps[row]))
         msg = (
             f"axis {joint + 1} would turn {np.degrees(jumps[row, joint]):.1f}° within "
-            f"{dist / count * 1000:.1f} mm at {fractions[row]:.0%} of the linear move: "
-            "it passes through or near a singularity"
+            f"{wording.quantity(dist / count * 1000)} mm at {wording.percent(fractions[row])} "
+            "of the linear move: it passes through or near a singularity"
         )
         hint = "use a joint move, or change the tool orientation to avoid the singular pose"
         return None, [_error("singularity", msg, index, ins, joints=path[row], hint=hint)]
     return path, []
+
+
+def _joint_target_error(
+    index: int, ins: Instruction, target: JointTarget, robot: Robot
+) -> Diagnostic | None:
+    """The error of a joint target with the wrong number of values or outside the limits."""
+    q = target.joints
+    if q.shape != (robot.dof,):
+        msg = f"joint target has {q.size} values, the robot has {robot.dof} axes"
+        return _error("bad_target", msg, index, ins)
+    bad = robot.limits.violations(q)
+    return _limit_error(index, ins, robot, q, bad) if np.any(bad) else None
+
+
+def _too_long(
+    index: int,
+    ins: Instruction,
+    start: FloatArray,
+    end: FloatArray,
+    count: float,
+    opts: ResolveOptions,
+) -> Diagnostic:
+    """A linear move that needs more samples than one check takes (a huge tool or frame)."""
+    dist, angle = (float(v) for v in pose_distance(start, end))
+    msg = (
+        f"the linear move is too long to check at the sampling step: "
+        f"{wording.quantity(dist * 1000)} mm and {wording.quantity(np.degrees(angle))}° of TCP "
+        f"motion need {count:.4g} samples at {wording.exact(opts.step_m * 1000)} mm / "
+        f"{wording.exact(np.degrees(opts.step_rad))}°, more than the {MAX_SAMPLES} one move "
+        "may have"
+    )
+    hint = "check the tool and frame of the move (units: mm in the station)"
+    return _error("too_long", msg, index, ins, hint=hint)
 
 
 def _unwrap(q0: FloatArray, sols: FloatArray) -> FloatArray:
@@ -574,14 +662,15 @@ def _unwrap(q0: FloatArray, sols: FloatArray) -> FloatArray:
 
 
 def _unreachable(index: int, ins: Instruction, robot: Robot, flange: FloatArray) -> Diagnostic:
-    sols = robot.solve(flange[None])[0]
+    with np.errstate(over="ignore", invalid="ignore"):
+        sols = robot.solve(flange[None])[0]
+        reach = float(np.linalg.norm((inv(robot.base) @ flange)[:3, 3])) * 1000
     finite = sols[np.all(np.isfinite(sols), axis=-1)]
     if finite.shape[0] == 0:
-        base = inv(robot.base) @ flange
-        reach = np.linalg.norm(base[:3, 3]) * 1000
+        far = f"{wording.quantity(reach)} mm" if np.isfinite(reach) else "beyond 1e308 mm"
         msg = (
-            f"target is out of the robot's reach (flange {reach:.1f} mm from the robot base "
-            "origin; no IK solution in any configuration)"
+            f"target is out of the robot's reach (flange {far} from the robot base origin; "
+            "no IK solution in any configuration)"
         )
         return _error("unreachable", msg, index, ins)
     excess = np.maximum(robot.limits.lower - finite, 0) + np.maximum(finite - robot.limits.upper, 0)
@@ -590,7 +679,8 @@ def _unreachable(index: int, ins: Instruction, robot: Robot, flange: FloatArray)
     joint = int(np.argmax(excess[best]))
     msg = (
         f"target is reachable only outside the joint limits: the nearest solution needs axis "
-        f"{joint + 1} at {np.degrees(finite[best, joint]):.2f}° (limits {_range(robot, joint)})"
+        f"{joint + 1} at {_degrees_outside(robot, joint, finite[best, joint])} "
+        f"(limits {_range(robot, joint)})"
     )
     return _error("joint_limit", msg, index, ins, joints=finite[best])
 
@@ -604,17 +694,28 @@ def _limit_error(
     fraction: float | None = None,
 ) -> Diagnostic:
     joint = int(np.argmax(bad))
-    where = "" if fraction is None else f" at {fraction:.0%} of the move"
+    where = "" if fraction is None else f" at {wording.percent(fraction)} of the move"
     msg = (
-        f"axis {joint + 1} at {np.degrees(q[joint]):.2f}°{where} is outside its limits "
-        f"{_range(robot, joint)}"
+        f"axis {joint + 1} at {_degrees_outside(robot, joint, q[joint])}{where} is outside "
+        f"its limits {_range(robot, joint)}"
     )
     return _error("joint_limit", msg, index, ins, joints=q)
 
 
+def _degrees_outside(robot: Robot, joint: int, value: float) -> str:
+    """A joint value (rad) in degrees, with the decimals that show it outside the limits, and
+    the unit (radians for a value beyond the float range in degrees)."""
+    lower, upper = np.degrees([robot.limits.lower[joint], robot.limits.upper[joint]])
+    with np.errstate(over="ignore"):
+        degrees = float(np.degrees(value))
+    if not np.isfinite(degrees):
+        return f"{float(value):.6g} rad"
+    return f"{wording.outside(degrees, float(lower), float(upper))}°"
+
+
 def _range(robot: Robot, joint: int) -> str:
     lower, upper = np.degrees([robot.limits.lower[joint], robot.limits.upper[joint]])
-    return f"{lower:.0f}° .. {upper:.0f}°"
+    return f"{wording.exact(float(lower))}° .. {wording.exact(float(upper))}°"
 
 
 def replace_step(step: Step, **changes: object) -> Step:

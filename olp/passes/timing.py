@@ -88,7 +88,7 @@ import toppra
 import toppra.algorithm as algo
 import toppra.constraint as constraint
 from numpy.typing import NDArray
-from ruckig import InputParameter, Result, Ruckig, Synchronization, Trajectory
+from ruckig import InputParameter, Result, Ruckig, RuckigError, Synchronization, Trajectory
 from scipy.interpolate import CubicSpline, PPoly
 from toppra.algorithm.algorithm import ParameterizationAlgorithm
 from toppra.solverwrapper.cy_seidel_solverwrapper import seidelWrapper
@@ -181,11 +181,25 @@ def time_program(
     units = plan_units(compiled, lengths)
     context = _Context(compiled, _time_table(other_times), options or TimingOptions(), lengths)
     steps, found = _time_units(context, units)
+    found += _overflow(steps)
     return dataclasses.replace(
         compiled,
         steps=tuple(steps),
         diagnostics=compiled.diagnostics + tuple(found) + tuple(_zone_stops(compiled, units)),
     )
+
+
+def _overflow(steps: Sequence[Step]) -> list[Diagnostic]:
+    """An error at the instruction where the running cycle time stops being a finite number
+    (each duration is finite, their sum need not be: two waits of 1e308 s)."""
+    with np.errstate(over="ignore"):
+        total = np.cumsum([step.duration for step in steps])
+    bad = np.flatnonzero(~np.isfinite(total))
+    if bad.size == 0:
+        return []
+    step = steps[int(bad[0])]
+    msg = "the cycle time up to here exceeds the largest number olp can represent"
+    return [Diagnostic("error", "timing", msg, step.instruction.span, step.index)]
 
 
 def _time_table(other_times: Mapping[str, float] | None) -> dict[str, float]:
@@ -410,6 +424,7 @@ def ptp_profile(
     dof = q0.size
     if np.max(np.abs(q1 - q0)) <= 1e-12:
         return JerkProfile.at_rest(q1)
+    _check_ptp_duration(q0, q1, robot, velocity_scale, accel_scale)
     inp = InputParameter(dof)
     inp.current_position = q0.tolist()
     inp.target_position = q1.tolist()
@@ -422,10 +437,40 @@ def ptp_profile(
     # pass sampled; for rest-to-rest moves it costs no time against time synchronisation.
     inp.synchronization = Synchronization.Phase
     trajectory = Trajectory(dof)
-    result = Ruckig(dof).calculate(inp, trajectory)
+    try:
+        result = Ruckig(dof).calculate(inp, trajectory)
+    except (RuckigError, ValueError) as exc:
+        # Ruckig raises on inputs it rejects, and its binding raises ValueError for result
+        # codes it has no name for (-101: the duration is beyond its numerical range).
+        first_line = next((line for line in str(exc).splitlines() if line.strip()), "")
+        raise TimingError(f"Ruckig could not time the joint move: {first_line}") from exc
     if result not in (Result.Working, Result.Finished):
         raise TimingError(f"Ruckig could not time the joint move ({result.name})")
     return _jerk_profile(trajectory)
+
+
+RUCKIG_MAX_DURATION = 7.6e3
+"""Longest joint move (s) Ruckig times: measured with ruckig 0.19, a move of 7,600 s is timed
+and a longer one returns its code -101 (trajectory duration beyond its numerical limits)."""
+
+
+def _check_ptp_duration(
+    q0: FloatArray, q1: FloatArray, robot: Robot, velocity_scale: float, accel_scale: float
+) -> None:
+    """Raise :class:`TimingError` if the joint move cannot take less than
+    :data:`RUCKIG_MAX_DURATION`: its time-optimal duration under the velocity and acceleration
+    limits alone (a trapezoid per axis; jerk limits only add time) is a lower bound."""
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+        velocity = robot.limits.velocity * velocity_scale
+        accel = robot.limits.acceleration * accel_scale
+        least = float(np.max(_trapezoid(np.abs(q1 - q0), velocity, accel)[1]))
+    if least <= RUCKIG_MAX_DURATION:
+        return
+    raise TimingError(
+        f"the joint move would take at least {least:.4g} s at {velocity_scale * 100:.3g}% of "
+        f"the axes' speed and {accel_scale * 100:.3g}% of their acceleration: longer than the "
+        f"{RUCKIG_MAX_DURATION:g} s a joint move can be timed (Ruckig); raise the joint speed"
+    )
 
 
 def _jerk_profile(trajectory: Trajectory) -> JerkProfile:
@@ -958,22 +1003,26 @@ def _time_chains(context: _Context, units: Sequence[Unit]) -> tuple[list[Step], 
     ``options.solver`` all at once."""
     robot, opts = context.compiled.station.robot, context.options
     done: list[Step] = []
+    found: list[Diagnostic] = []
     posed: list[tuple[list[Step], ChainGeometry, PathProblem]] = []
     for unit in units:
         steps = [context.compiled.steps[i] for i in unit.indices]
         tool = steps[0].tool.pose if steps[0].tool is not None else None
         assert tool is not None
+        given = [s.instruction.speed for s in steps if is_motion(s.instruction)]
+        linear = np.array([sp.linear for sp in given], dtype=np.float64)
+        angular = np.array([np.inf if sp.angular is None else sp.angular for sp in given])
+        slow = _too_slow(steps, linear, angular)
+        if slow is not None:
+            found.append(slow)
+            continue
         paths = [s.path for s in steps if s.path is not None]
         geometry = chain_geometry(paths, robot, tool, unit.blends, opts.blend_samples)
         if geometry.s[-1] <= 0.0:  # no joint moves: the TCP stays put
             done += [dataclasses.replace(s, duration=0.0, path_length=0.0) for s in steps]
             continue
-        given = [s.instruction.speed for s in steps if is_motion(s.instruction)]
-        linear = np.array([sp.linear for sp in given], dtype=np.float64)
-        angular = np.array([np.inf if sp.angular is None else sp.angular for sp in given])
         posed.append((steps, geometry, path_problem(geometry, tool, linear, angular, opts)))
     speeds = PATH_SOLVERS[opts.solver]([problem for _, _, problem in posed], robot)
-    found: list[Diagnostic] = []
     for (steps, geometry, problem), sd in zip(posed, speeds, strict=True):
         try:
             done += _timed_chain(steps, geometry, _time_law(problem, sd))
@@ -981,6 +1030,31 @@ def _time_chains(context: _Context, units: Sequence[Unit]) -> tuple[list[Step], 
             span = steps[0].instruction.span
             found.append(Diagnostic("error", "timing", str(exc), span, steps[0].index))
     return done, found
+
+
+MIN_PATH_SPEED = 1e-150
+"""Slowest TCP speed (m/s, and rad/s for an orientation speed) a path move is timed at. The
+solver works with the squared path speed ``(v / rate)²``, rate up to ~10 m/rad: below this it
+would leave the normal float range (2.2e-308) and the time law would lose its digits, then
+vanish (measured: 1e-160 m/s timed 5e-7 off, 1e-300 m/s found no time law)."""
+
+
+def _too_slow(steps: Sequence[Step], linear: FloatArray, angular: FloatArray) -> Diagnostic | None:
+    """The error for a chain with a programmed speed below :data:`MIN_PATH_SPEED`."""
+    slow = np.flatnonzero((linear < MIN_PATH_SPEED) | (angular < MIN_PATH_SPEED))
+    if slow.size == 0:
+        return None
+    k = int(slow[0])
+    which, value, unit = (
+        ("TCP speed", linear[k] * 1000, "mm/s")
+        if linear[k] < MIN_PATH_SPEED
+        else ("orientation speed", np.degrees(angular[k]), "°/s")
+    )
+    msg = (
+        f"the programmed {which} of {value:.3g} {unit} is too low to time (the slowest olp "
+        f"times is {MIN_PATH_SPEED:g} m/s or rad/s)"
+    )
+    return Diagnostic("error", "timing", msg, steps[k].instruction.span, steps[k].index)
 
 
 def _timed_chain(steps: Sequence[Step], geometry: ChainGeometry, law: PathTimeLaw) -> list[Step]:
@@ -1158,7 +1232,7 @@ def speed_bounds(
 
 def _rate_bound(rate: FloatArray, limit: FloatArray) -> FloatArray:
     """``x <= (limit / rate)²`` (K,) for ``rate * ds/dt <= limit``; no bound where rate is 0."""
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         out: FloatArray = np.where(rate > 0, (limit / rate) ** 2, np.inf)
     return out
 
@@ -1192,15 +1266,17 @@ def _solve_batch(problems: Sequence[PathProblem], robot: Robot) -> list[FloatArr
         return []
     sizes = np.array([p.grid.size for p in problems], dtype=np.int64)
     first = np.cumsum(sizes) - sizes
-    # End to end on one axis, 1 apart (a stage between two problems stays at rest).
-    offset = np.cumsum([0.0, *(p.grid[-1] + 1.0 for p in problems[:-1])])
-    grid = np.concatenate([p.grid + shift for p, shift in zip(problems, offset, strict=True)])
+    # End to end, a stage of length 1 between two problems (it stays at rest). The stage
+    # lengths are joined, not the gridpoints shifted: a shift of ~1 rounds away the spacing of
+    # a short problem's grid (1e-17 near the ends of a 3e-10 rad move), which made zero-length
+    # stages and no time law.
+    delta = np.concatenate([part for p in problems for part in (np.diff(p.grid), np.ones(1))][:-1])
     q, dq, ddq = (np.concatenate([p.path(p.grid, k) for p in problems]) for k in range(3))
     linear = np.concatenate([p.linear for p in problems])
     angular = np.concatenate([p.angular for p in problems])
     bound = speed_bounds(robot, q, dq, _row_tools(problems, sizes), linear, angular)
     bound[first], bound[first + sizes - 1] = 0.0, 0.0  # every chain starts and ends at rest
-    sd = reachability_speeds(grid, dq, ddq, bound, robot.limits.acceleration)
+    sd = _reachability(delta, dq, ddq, bound, robot.limits.acceleration)
     return np.split(sd, first[1:])
 
 
@@ -1235,9 +1311,16 @@ def reachability_speeds(
     longest run of deceleration- (acceleration-) limited stages, each sweep in numpy. The
     result is TOPPRA's without its shrink of ``x`` by 1e-8 per forward step.
     """
+    return _reachability(np.diff(grid), dq, ddq, x_max, accel)
+
+
+def _reachability(
+    delta: FloatArray, dq: FloatArray, ddq: FloatArray, x_max: FloatArray, accel: FloatArray
+) -> FloatArray:
+    """:func:`reachability_speeds` given the stage lengths ``delta`` (K - 1,)."""
     if not (np.all(np.isfinite(dq)) and np.all(np.isfinite(ddq)) and not np.any(np.isnan(x_max))):
-        return np.full(grid.size, np.nan)
-    rows = _StageRows.of(grid, dq, ddq, accel)
+        return np.full(delta.size + 1, np.nan)
+    rows = _StageRows(delta, dq, ddq, np.concatenate([accel, accel]))
     cap = np.minimum(x_max[:-1], _stage_caps(rows))
     controllable = _backward(rows, np.append(cap, 0.0))
     return np.sqrt(_forward(rows, controllable))
@@ -1253,10 +1336,6 @@ class _StageRows:
     dq: FloatArray
     ddq: FloatArray
     accel: FloatArray
-
-    @classmethod
-    def of(cls, grid: FloatArray, dq: FloatArray, ddq: FloatArray, accel: FloatArray) -> _StageRows:
-        return cls(np.diff(grid), dq, ddq, np.concatenate([accel, accel]))
 
     @property
     def stages(self) -> int:

@@ -302,3 +302,114 @@ def test_resolve_reads_each_instruction_a_bounded_number_of_times(station: Stati
     compiled = resolve(ir.Program(name="t", instructions=instructions), station)
     assert compiled.ok and len(compiled.steps) == count + 2
     assert _CountingTuple.reads <= 4 * len(instructions)
+
+
+# --------------------------------------------------------------------------------------------
+# Absurd but parseable values: diagnostics, never exceptions or unbounded memory (issue 10)
+
+
+def _counted_sampling(monkeypatch: pytest.MonkeyPatch) -> list[int]:
+    """Record the segments and samples of every ``sample_segments`` call resolve makes, and
+    fail (before anything is allocated) a call that would make over a million samples."""
+    import olp.passes.resolve as module
+    from olp.geometry import pose_distance
+
+    original = module.sample_segments
+    calls: list[int] = []
+
+    def counted(start, targets, step_m, step_rad):  # type: ignore[no-untyped-def]
+        previous = np.concatenate([start[None], targets[:-1]])
+        lengths, angles = pose_distance(previous, targets)
+        with np.errstate(over="ignore", invalid="ignore"):
+            wanted = np.sum(np.maximum(np.ceil(lengths / step_m), np.ceil(angles / step_rad)))
+        assert wanted <= 1e6, f"resolve asked for {wanted:.3g} samples"
+        calls.append(len(targets))
+        return original(start, targets, step_m, step_rad)
+
+    monkeypatch.setattr(module, "sample_segments", counted)
+    return calls
+
+
+@pytest.mark.parametrize("metres", [1e5, 1e40, 1e300])
+def test_a_far_target_in_a_run_of_lins_is_unreachable(
+    station: Station, monkeypatch: pytest.MonkeyPatch, metres: float
+) -> None:
+    """A CSV's ``400,0,1e40`` row gave ``ValueError: negative dimensions``, a 100 km LIN 7 GB of
+    samples: the batch now counts samples before it makes them."""
+    _counted_sampling(monkeypatch)
+    near = _lin_to_joints(station, [5, -85, 95, 0, 20, 0], 2)
+    far = ir.LinearMove(target=ir.CartesianTarget(pose=transl(metres, 0, 0.5)), span=_span(3))
+    back = _lin_to_joints(station, [5, -80, 95, 0, 20, 0], 4)
+    start = _ptp([0, -90, 90, 0, 30, 0])
+    compiled = resolve(ir.Program(name="t", instructions=[start, near, far, back]), station)
+    assert [(d.severity, d.kind, d.span.line) for d in compiled.diagnostics] == [
+        ("error", "unreachable", 3)
+    ]
+    message = compiled.diagnostics[0].message
+    assert len(message) < 150  # the distance in short form (1e+43 mm), not 40 digits
+    assert compiled.steps[3].joints is not None  # the move after it is still resolved
+
+
+def _long_tool(metres: float) -> ir.Tool:
+    return ir.Tool(name="long", pose=transl(metres, 0, 0))
+
+
+def test_a_lin_too_long_to_sample_is_an_error_in_a_batch_and_alone(
+    station: Station, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A 1 km tool turned by 30° moves its TCP ~500 m: 100,000 samples at 5 mm, over the cap
+    of one move. Both the batched (Cartesian target) and the per-move path (joint target)
+    report it on the move's line instead of sampling it."""
+    from olp.passes.sampling import MAX_SAMPLES
+
+    calls = _counted_sampling(monkeypatch)
+    tool = _long_tool(1000.0)
+    start = [0, -90, 90, 0, 30, 0]
+    end = [30, -90, 90, 0, 30, 0]
+    pose = station.robot.flange_poses(np.radians(end)) @ tool.pose
+    cartesian = ir.LinearMove(target=ir.CartesianTarget(pose=pose), tool=tool, span=_span(2))
+    joints = ir.LinearMove(target=ir.JointTarget(joints=np.radians(end)), tool=tool, span=_span(3))
+    for move in (cartesian, joints):
+        first = ir.JointMove(target=ir.JointTarget(joints=np.radians(start)), tool=tool)
+        compiled = resolve(ir.Program(name="t", instructions=[first, move]), station)
+        assert [(d.kind, d.span.line) for d in compiled.diagnostics] == [
+            ("too_long", move.span.line)
+        ]
+        assert f"more than the {MAX_SAMPLES}" in compiled.diagnostics[0].message
+    assert sum(calls) == 0  # nothing was sampled
+
+
+def test_a_lin_to_an_absurd_joint_target_is_a_limit_error(station: Station) -> None:
+    """A LIN to joints of 1e308 rad crashed (NaN sample count); a wrong number of joints too."""
+    huge = ir.LinearMove(target=ir.JointTarget(joints=np.full(6, 1e308)), span=_span(2))
+    short = ir.LinearMove(target=ir.JointTarget(joints=np.zeros(5)), span=_span(3))
+    found = _run(station, _ptp(HOME), huge, short)
+    assert found == [("joint_limit", 2), ("bad_target", 3)]
+    compiled = resolve(ir.Program(name="t", instructions=[_ptp(HOME), huge]), station)
+    assert "1e+308 rad" in compiled.diagnostics[0].message
+
+
+def test_many_failing_lins_are_not_resampled_quadratically(
+    station: Station, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """After a failure the batch restarts small: each failing move re-sampled the rest of its
+    batch of 4,096 moves before (2,000 unreachable targets: 28 s)."""
+    calls = _counted_sampling(monkeypatch)
+    count = 100
+    far = [
+        ir.LinearMove(target=ir.CartesianTarget(pose=transl(1.5, 0.001 * i, 0.5)), span=_span(i))
+        for i in range(count)
+    ]
+    start = _ptp([0, -90, 90, 0, 30, 0])
+    compiled = resolve(ir.Program(name="t", instructions=[start, *far]), station)
+    assert [d.kind for d in compiled.diagnostics] == ["unreachable"] * count
+    assert sum(calls) <= 20 * count  # segments sampled: ~17 per failure, not ~count / 2
+
+
+def test_a_limit_message_shows_the_digits_that_make_the_value_outside(station: Station) -> None:
+    """``A1 170.00001`` was reported as "170.00° outside -170..170"."""
+    move = _ptp([170.00001, -90, 90, 0, 0, 0], 2)
+    compiled = resolve(ir.Program(name="t", instructions=[move]), station)
+    (found,) = compiled.diagnostics
+    assert found.kind == "joint_limit"
+    assert "axis 1 at 170.00001° is outside its limits -170° .. 170°" in found.message

@@ -691,3 +691,119 @@ def test_collinear_samples_make_a_line_and_a_bend_does_not(station: Station, too
     assert kinds == [LineTimeLaw, PathTimeLaw]
     # the same move to 2e-7 rad; the solver's default grid is ~1% slow on so short a path
     assert timed.steps[0].duration == pytest.approx(timed.steps[1].duration, rel=2e-2)
+
+
+# --------------------------------------------------------------------------------------------
+# Absurd but parseable values: a timing diagnostic on the instruction, never an exception
+
+
+def _ptp_at(station: Station, speed: ir.Speed) -> CompiledProgram:
+    moves = [
+        ir.JointMove(target=ir.JointTarget(joints=Q0)),
+        ir.JointMove(target=ir.JointTarget(joints=Q0 + 0.2), speed=speed, span=SPAN),
+    ]
+    return time_program(resolve(ir.Program(name="t", instructions=moves), station))
+
+
+SPAN = ir.SourceSpan("t.src", 7, 1)
+
+
+@pytest.mark.parametrize(
+    "speed",
+    [ir.Speed(joint=1e-8), ir.Speed(joint=1e-300), ir.Speed(joint_acceleration=1e-300)],
+)
+def test_a_joint_move_too_slow_for_ruckig_is_a_timing_error(
+    station: Station, speed: ir.Speed
+) -> None:
+    """``$VEL_AXIS[1] = 0.000001`` gave Ruckig's ``-101 is not a valid Result`` (a ValueError),
+    1e-300 a RuckigError: Ruckig times joint moves up to 7,600 s."""
+    compiled = _ptp_at(station, speed)
+    assert [(d.severity, d.kind, d.span) for d in compiled.diagnostics] == [
+        ("error", "timing", SPAN)
+    ]
+    assert "7600 s" in compiled.diagnostics[0].message
+
+
+def test_ruckig_s_longest_move_is_timed(station: Station) -> None:
+    """Just inside the bound the move is timed, and takes about the bound."""
+    q0, q1 = np.zeros(6), np.array([0.2, 0, 0, 0, 0, 0])
+    scale = 0.2 / (timing.RUCKIG_MAX_DURATION * 0.99) / station.robot.limits.velocity[0]
+    duration = ptp_duration(q0, q1, station.robot, velocity_scale=scale)
+    assert 0.98 * timing.RUCKIG_MAX_DURATION < duration < timing.RUCKIG_MAX_DURATION
+
+
+def _ruckig_failures() -> list[Exception]:
+    from ruckig import RuckigError
+
+    return [ValueError("-101 is not a valid Result."), RuckigError("[ruckig] error\ndetails")]
+
+
+@pytest.mark.parametrize("error", _ruckig_failures(), ids=["unnamed result", "rejected input"])
+def test_any_ruckig_failure_is_a_timing_error(
+    station: Station, monkeypatch: pytest.MonkeyPatch, error: Exception
+) -> None:
+    class Failing:
+        def __init__(self, dof: int) -> None:
+            del dof
+
+        def calculate(self, *args: object) -> None:
+            raise error
+
+    monkeypatch.setattr(timing, "Ruckig", Failing)
+    with pytest.raises(timing.TimingError, match="Ruckig could not time the joint move"):
+        ptp_profile(Q0, Q0 + 0.2, station.robot)
+
+
+def test_speed_sweep_with_an_absurd_joint_speed_gives_nan(station: Station) -> None:
+    compiled = _ptp_at(station, ir.Speed())
+    table = speed_sweep(compiled, [None], [1e-300, 1.0])
+    assert np.isnan(table[0, 0]) and np.isfinite(table[0, 1])
+
+
+@pytest.mark.parametrize("speed", [ir.Speed(linear=1e-300), ir.Speed(angular=1e-300)])
+def test_a_path_move_too_slow_to_time_says_so(
+    station: Station, tool: ir.Tool, speed: ir.Speed
+) -> None:
+    """1e-300 m/s was reported as "cannot be followed without stopping (a cusp)"."""
+    move = dataclasses.replace(_lin(station, tool, [0, 0, -0.02], 0.1), speed=speed, span=SPAN)
+    start = ir.JointMove(target=ir.JointTarget(joints=Q0), tool=tool)
+    compiled = time_program(resolve(ir.Program(name="t", instructions=[start, move]), station))
+    assert [(d.kind, d.span) for d in compiled.diagnostics] == [("timing", SPAN)]
+    assert "too low to time" in compiled.diagnostics[0].message
+
+
+def test_a_slow_path_move_is_timed_down_to_the_floor(station: Station, tool: ir.Tool) -> None:
+    """1 um/s is slow, not absurd: timed as length / speed."""
+    compiled = _compiled(station, tool, _lin(station, tool, [0, 0, -0.02], 1e-6))
+    assert compiled.steps[1].duration == pytest.approx(0.02 / 1e-6, rel=1e-4)
+
+
+@pytest.mark.parametrize("length", [1e-9, 1e-10, 1e-12])
+def test_tiny_moves_after_others_are_timed(station: Station, tool: ir.Tool, length: float) -> None:
+    """Problems solved together sat end to end on one axis, 1 apart: a tiny move's gridpoints
+    (1e-17 apart) rounded together there and it found no time law."""
+    moves = [
+        _lin(station, tool, [0.01, 0, 0], 0.1),
+        _lin(station, tool, [0.01 + length, 0, 0], 0.1),
+        _lin(station, tool, [0.01 + length, length, 0], 0.1),
+    ]
+    compiled = _compiled(station, tool, *moves)
+    alone = [_compiled(station, tool, moves[0], m) for m in moves[1:]]
+    assert [s.duration for s in alone[0].steps[2:]] == [compiled.steps[2].duration]
+    assert 0 < compiled.steps[3].duration < 1e-3
+
+
+def test_a_cycle_time_beyond_the_float_range_is_an_error(station: Station) -> None:
+    """Two waits of 1e308 s are each finite; their sum is not."""
+    program = ir.Program(
+        name="t",
+        instructions=[
+            ir.JointMove(target=ir.JointTarget(joints=Q0)),
+            ir.Wait(seconds=1e308),
+            ir.Wait(seconds=1e308, span=SPAN),
+        ],
+    )
+    compiled = time_program(resolve(program, station))
+    assert [(d.severity, d.kind, d.span) for d in compiled.diagnostics] == [
+        ("error", "timing", SPAN)
+    ]

@@ -1,0 +1,47 @@
+"""Issue 10's reproductions, end to end through a frontend on the KR 6 milling cell: absurd but
+parseable programs give located diagnostics, never a traceback or unbounded memory."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from olp.api import build
+from olp.station.loader import load_station
+from olp.station.model import Station
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="module")
+def station() -> Station:
+    return load_station(REPO / "stations" / "kr6_milling_cell.yaml")
+
+
+def _errors(station: Station, path: Path) -> list[tuple[str, int]]:
+    result = build(station, path, post="kuka")
+    assert not result.files
+    return [(d.kind, d.span.line) for d in result.diagnostics if d.severity == "error" and d.span]
+
+
+@pytest.mark.parametrize("far", ["1e40", "1e300", "100000400"])
+def test_a_far_csv_target_is_unreachable_on_its_row(
+    station: Station, tmp_path: Path, far: str
+) -> None:
+    """``x,y,z`` / ``400,0,500`` / ``400,0,1e40``: ValueError (negative dimensions); 100 km: a
+    7 GB sample array and MemoryError."""
+    program = tmp_path / "far.csv"
+    program.write_text(f"x,y,z\n400,0,500\n400,0,{far}\n")
+    assert _errors(station, program) == [("unreachable", 3)]
+
+
+def test_a_tiny_krl_joint_speed_is_a_timing_error_on_the_ptp(
+    station: Station, tmp_path: Path
+) -> None:
+    """``$VEL_AXIS[1] = 0.000001`` then a PTP: Ruckig's ``-101 is not a valid Result``."""
+    program = tmp_path / "slow.src"
+    program.write_text(
+        "DEF slow()\n$VEL_AXIS[1] = 0.000001\nPTP {A1 10,A2 -90,A3 90,A4 0,A5 30,A6 0}\nEND\n"
+    )
+    assert _errors(station, program) == [("timing", 3)]
