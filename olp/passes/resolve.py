@@ -7,7 +7,10 @@
 * A linear move must stay in one IK branch: the straight TCP line is sampled (``step_m``,
   ``step_rad``), solved in the branch of the start joints and unwrapped continuously. Leaving the
   workspace, a joint limit, or a joint jump between samples (a singularity or a configuration
-  flip) is an error on that instruction.
+  flip) is an error on that instruction; so is a move that needs more samples than one check
+  takes (:data:`olp.passes.sampling.MAX_SAMPLES`), counted before any is made. A path that
+  starts, ends or passes at a singular pose (wrist, shoulder, elbow) without a jump gets a
+  warning (:func:`_singular_warnings`).
 
 The result is a :class:`CompiledProgram`: the program, one :class:`Step` per instruction (end
 joints, resolved tool and frame, sampled joint path of a motion) and the diagnostics.
@@ -39,6 +42,7 @@ from olp.ir import (
     is_motion,
 )
 from olp.kinematics.base import turn_variants
+from olp.kinematics.singularity import singularity_distances
 from olp.passes import wording
 from olp.passes.sampling import MAX_SAMPLES, SegmentSamples, sample_segments, segment_counts
 from olp.station.model import Robot, Station
@@ -61,6 +65,9 @@ class ResolveOptions:
     ``fallback_joint``: a linear move that cannot run becomes a joint move to the same target
     when that one can (USERS.md jobs 2 and 6), with a warning. ``skip_unreachable``: a target
     that no move can reach is dropped with a warning instead of an error (job 4).
+    ``singular_angle_rad`` (wrist, elbow) and ``singular_distance_m`` (shoulder): a linear
+    path that comes this close to a singular pose gets a warning (see
+    :func:`_singular_warnings`).
     """
 
     step_m: float = 0.005
@@ -69,6 +76,11 @@ class ResolveOptions:
     weights: tuple[float, ...] = (1.0, 1.0, 1.0, 1.0, 1.0, 1.0)
     fallback_joint: bool = False
     skip_unreachable: bool = False
+    # A pose printed to 0.001 mm and 0.001° (KRL, Fanuc) fixes a free joint to within 1° only
+    # beyond 0.001° / 1° = 1e-3 rad of a wrist (elbow) singularity and 0.001 mm / 1° = 0.06 mm
+    # of a shoulder singularity; nearer than that, the pose does not decide the joints.
+    singular_angle_rad: float = 1e-3
+    singular_distance_m: float = 1e-4
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -223,6 +235,8 @@ def _resolve_linear_run(
             moves = chunk[:good]
             diags.extend(_speed_warnings(first + k, moves, batch.path, samples, state.robot))
             ends = samples.ends[:good] + 1
+            fractions = np.concatenate([[0.0], samples.fractions[: int(ends[-1])]])
+            diags.extend(_singular_warnings(first + k, moves, batch.path, ends, fractions, state))
             steps.extend(_batch_steps(first + k, moves, batch.path, ends))
             state.q = batch.path[int(ends[-1])].copy()
         if batch.bad is not None:
@@ -365,6 +379,129 @@ def _true_runs(mask: NDArray[np.bool_]) -> list[tuple[int, int]]:
     return list(
         zip(np.flatnonzero(edges == 1).tolist(), np.flatnonzero(edges == -1).tolist(), strict=True)
     )
+
+
+_SINGULARITIES = (
+    (
+        "wrist",
+        "axis 5 {angle}° from lining up axes 4 and 6",
+        "the pose does not fix how axes 4 and 6 share the turn",
+        "turn axis 5 away from 0° before the move (a joint move), or tilt the tool",
+    ),
+    (
+        "shoulder",
+        "{place}: {distance} mm",
+        "the pose does not fix axis 1",
+        "keep the wrist away from axis 1: move the path, or change the tool orientation",
+    ),
+    (
+        "elbow",
+        "the arm {angle}° from fully stretched or folded",
+        "the arm cannot move further out or in there",
+        "keep the path inside the reach: move it closer to (or farther from) the robot",
+    ),
+)
+"""Per singularity: its name, how far the pose is from it, what is undefined there, a hint."""
+
+
+def _singular_warnings(
+    first: int,
+    moves: list[tuple[LinearMove, Tool, Frame]],
+    path: FloatArray,
+    ends: IntArray,
+    fractions: FloatArray,
+    state: _State,
+) -> list[Diagnostic]:
+    """Warn where a resolved linear path starts, ends or passes at a singular pose.
+
+    ``path`` (S + 1, 6) rad: the joint path of consecutive moves from their start (row 0);
+    ``ends`` (M,): each move's last row; ``fractions`` (S + 1,): each row's position within
+    its move (0 at row 0). Distances come from the kinematic model
+    (:func:`olp.kinematics.singularity.singularity_distances`), at every row and, where the
+    distance has a local minimum, at the vertex of the parabola through it and its neighbours
+    (a touch between two samples); a row counts when within ``singular_angle_rad`` (wrist,
+    elbow) or ``singular_distance_m`` (shoulder) of the singularity.
+
+    Why a warning and not an error: a path that reaches this pass stayed in one IK branch
+    with no joint jump, so the joint path olp planned, checked and timed exists and is
+    continuous (a linear move whose path is undefined at a singularity, e.g. one that must
+    turn axes 4 and 6 by 180° in an instant, already failed with an error). But at the
+    singular pose the pose alone no longer determines the joints: the controller's own
+    Cartesian interpolation has to pick them (from the joints it comes from) and its Jacobian
+    is singular there. Vendors document that Cartesian moves at or through singular poses may
+    stop with a message or slow down: KUKA names the alpha-1 (overhead), alpha-2 (extended)
+    and alpha-5 (wrist) singularities, and its $SINGUL_POS settles the free axes only for a PTP
+    end point; ABB's SingArea\\Wrist lets a linear move deviate in orientation to pass the
+    wrist singularity. So olp keeps the program but says where the controller's joints may
+    differ from olp's path, or the move may stop.
+    """
+    found = singularity_distances(state.robot.kinematics, path)
+    if found is None:  # numeric kinematics: no named branches to measure from
+        return []
+    tolerance = {
+        "wrist": np.sin(state.opts.singular_angle_rad),
+        "shoulder": state.opts.singular_distance_m,
+        "elbow": np.sin(state.opts.singular_angle_rad),
+    }
+    starts = np.concatenate([[0], ends[:-1]])
+    out: list[Diagnostic] = []
+    for name, detail, undefined, hint in _SINGULARITIES:
+        distance = _closest(getattr(found, name))
+        per_move = np.minimum(np.minimum.reduceat(distance[: ends[-1]], starts), distance[ends])
+        for lo, hi in _true_runs(per_move <= tolerance[name]):
+            rows = np.arange(int(starts[lo]), int(ends[lo]) + 1)
+            row = int(rows[np.argmax(distance[rows] <= tolerance[name])])
+            if row == starts[lo]:
+                verb = "starts in"
+            elif row == ends[lo]:
+                verb = "ends in"
+            else:
+                verb = f"passes (at {wording.percent(float(fractions[row]))} of the move)"
+            amount = float(distance[row])
+            text = detail.format(
+                angle=wording.quantity(float(np.degrees(np.arcsin(min(amount, 1.0)))), 3),
+                distance=wording.quantity(amount * 1000, 3),
+                place=found.shoulder_place,
+            )
+            also = "" if hi - lo == 1 else f"; moves {first + lo + 1}-{first + hi - 1} too"
+            out.append(
+                Diagnostic(
+                    "warning",
+                    "singularity",
+                    f"linear move {first + lo} {verb} the {name} singularity ({text}): "
+                    f"{undefined}, so the controller may stop the move there or take other "
+                    f"joint values than olp planned{also}",
+                    moves[lo][0].span,
+                    first + lo,
+                    joints=path[row],
+                    hint=hint,
+                )
+            )
+    return out
+
+
+def _closest(values: FloatArray) -> FloatArray:
+    """Distances (S,) from zero of a signed quantity sampled along a path (S,): ``|values|``,
+    lowered where a local minimum of it has a lower parabola vertex between its neighbours,
+    and 0 where the sign changes (a crossing between two samples)."""
+    out = np.abs(values)
+    if values.size < 3:
+        if values.size == 2 and values[0] * values[1] < 0:
+            out[:] = 0.0
+        return out
+    before, here, after = values[:-2], values[1:-1], values[2:]
+    curve = after - 2.0 * here + before
+    with np.errstate(divide="ignore", invalid="ignore"):
+        vertex = here - (after - before) ** 2 / (8.0 * curve)
+    # Only at a local minimum of |values| does the parabola's vertex lie between the two
+    # neighbours; it comes nearer to zero only if the parabola curves away from zero.
+    minimum = (np.abs(here) <= np.abs(before)) & (np.abs(here) <= np.abs(after))
+    towards = minimum & (np.sign(curve) == np.sign(here)) & (np.abs(vertex) < np.abs(here))
+    dip = np.where(towards, np.where(vertex * here <= 0, 0.0, np.abs(vertex)), out[1:-1])
+    out[1:-1] = np.minimum(out[1:-1], dip)
+    crossing = np.flatnonzero(values[:-1] * values[1:] < 0)
+    out[crossing] = 0.0
+    return out
 
 
 def _world(frame: Frame) -> FloatArray:
@@ -616,7 +753,8 @@ def _linear_path(
         )
         hint = "use a joint move, or change the tool orientation to avoid the singular pose"
         return None, [_error("singularity", msg, index, ins, joints=path[row], hint=hint)]
-    return path, []
+    ends = np.array([count], dtype=np.int64)
+    return path, _singular_warnings(index, [(ins, tool, frame)], path, ends, fractions, state)
 
 
 def _joint_target_error(

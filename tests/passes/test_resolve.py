@@ -413,3 +413,93 @@ def test_a_limit_message_shows_the_digits_that_make_the_value_outside(station: S
     (found,) = compiled.diagnostics
     assert found.kind == "joint_limit"
     assert "axis 1 at 170.00001° is outside its limits -170° .. 170°" in found.message
+
+
+# --------------------------------------------------------------------------------------------
+# Singular poses on a linear path (issue 10, item 13)
+
+
+def _warnings(station: Station, *instructions: ir.Instruction) -> list[tuple[str, int, str]]:
+    compiled = resolve(ir.Program(name="t", instructions=instructions), station)
+    assert compiled.ok, [d.message for d in compiled.diagnostics]
+    return [(d.kind, d.span.line, d.message) for d in compiled.diagnostics if d.span is not None]
+
+
+def _down(station: Station, deg: list[float], metres: float, line: int) -> ir.LinearMove:
+    """A LIN moving the flange straight down by ``metres`` from the pose of joints ``deg``."""
+    pose = transl(0, 0, -metres) @ station.robot.flange_poses(np.radians(deg))
+    return ir.LinearMove(target=ir.CartesianTarget(pose=pose), span=_span(line))
+
+
+def _overhead(station: Station) -> list[float]:
+    """Joints (deg) with the wrist centre exactly on axis 1: A2 solved for A3 = 60°."""
+    from scipy.optimize import brentq
+
+    from olp.kinematics.configuration import wrist_x
+
+    def x(a2: float) -> float:
+        return float(wrist_x(station.robot, np.radians([30, a2, 60, 0, 40, 0])))
+
+    return [30, brentq(x, -130, -100, xtol=1e-14), 60, 0, 40, 0]
+
+
+def test_a_lin_starting_at_the_home_wrist_singularity_warns(station: Station) -> None:
+    """KUKA HOME has A5 = 0: straight down from there stays in one branch without a jump (so
+    no error), but the pose does not fix A4 and A6."""
+    (found,) = _warnings(station, _ptp(HOME), _down(station, HOME, 0.05, 3))
+    assert found[:2] == ("singularity", 3)
+    assert "linear move 1 starts in the wrist singularity" in found[2]
+
+
+def test_a_lin_ending_with_the_wrist_centre_on_axis_1_warns(station: Station) -> None:
+    overhead = _overhead(station)
+    above = [overhead[0], overhead[1] + 3, *overhead[2:]]
+    (found,) = _warnings(station, _ptp(above), _lin_to_joints(station, overhead, 4))
+    assert found[:2] == ("singularity", 4)
+    assert "ends in the shoulder singularity (wrist centre to axis 1: " in found[2]
+    (start,) = _warnings(station, _ptp(overhead), _down(station, overhead, 0.05, 5))
+    assert start[:2] == ("singularity", 5) and "starts in the shoulder singularity" in start[2]
+
+
+def test_a_lin_ending_with_the_arm_stretched_warns(station: Station) -> None:
+    """The KR 6's arm is straight at A3 = atan(35 / 420) (a2 = -35 mm, c3 = 420 mm)."""
+    straight = [0, -60, float(np.degrees(np.arctan2(0.035, 0.420))), 0, 40, 0]
+    bent = [0, -60, straight[2] + 10, 0, 40, 0]
+    target = ir.LinearMove(target=ir.JointTarget(joints=np.radians(straight)), span=_span(6))
+    (found,) = _warnings(station, _ptp(bent), target)
+    assert found[:2] == ("singularity", 6) and "ends in the elbow singularity" in found[2]
+
+
+def test_lins_away_from_singular_poses_do_not_warn(station: Station) -> None:
+    start = [10, -80, 95, 20, 30, 40]
+    assert _warnings(station, _ptp(start), _down(station, start, 0.05, 2)) == []
+
+
+def test_batched_and_per_move_paths_warn_alike(
+    station: Station, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    moves = [_down(station, HOME, 0.002 * (k + 1), k + 2) for k in range(5)]
+    program = ir.Program(name="t", instructions=[_ptp(HOME), *moves])
+    batched = resolve(program, station)
+    single = _per_move(monkeypatch, program, station)
+    found = [(d.kind, d.index, d.message) for d in batched.diagnostics]
+    assert found == [(d.kind, d.index, d.message) for d in single.diagnostics]  # type: ignore[attr-defined]
+    assert [(kind, index) for kind, index, _ in found] == [("singularity", 1)]
+
+
+def test_a_ur_lin_starting_with_wrist_2_at_zero_warns() -> None:
+    ur = load_station(REPO / "stations" / "ur5e_screw_cell.yaml")
+    start = [0, -90, 90, -90, 0, 0]
+    (found,) = _warnings(ur, _ptp(start), _down(ur, start, 0.05, 2))
+    assert found[:2] == ("singularity", 2) and "starts in the wrist singularity" in found[2]
+
+
+def test_a_touch_between_two_samples_counts() -> None:
+    """A distance that dips to zero between samples (a parabola through 0 at 2.5)."""
+    from olp.passes.resolve import _closest
+
+    values = (np.arange(6.0) - 2.5) ** 2 / 10 + 0.0
+    assert np.min(_closest(values)) == pytest.approx(0.0, abs=1e-15)
+    assert _closest(np.array([0.3, 0.2, 0.25]))[1] == pytest.approx(0.2 - 0.05**2 / (8 * 0.15))
+    assert np.min(_closest(np.array([0.2, 0.1, -0.1, -0.2]))) == 0.0  # a crossing
+    assert np.all(_closest(np.array([0.3, 0.3001, 0.3002])) == [0.3, 0.3001, 0.3002])

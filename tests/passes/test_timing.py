@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -732,22 +733,28 @@ def test_ruckig_s_longest_move_is_timed(station: Station) -> None:
     assert 0.98 * timing.RUCKIG_MAX_DURATION < duration < timing.RUCKIG_MAX_DURATION
 
 
-def _ruckig_failures() -> list[Exception]:
+def _unnamed_result() -> Exception:
+    return ValueError("-101 is not a valid Result.")
+
+
+def _rejected_input() -> Exception:
     from ruckig import RuckigError
 
-    return [ValueError("-101 is not a valid Result."), RuckigError("[ruckig] error\ndetails")]
+    return RuckigError("[ruckig] error in step 1\ndetails")
 
 
-@pytest.mark.parametrize("error", _ruckig_failures(), ids=["unnamed result", "rejected input"])
+# Factories, not instances: a raised exception keeps its traceback, whose frames hold Ruckig's
+# objects; an instance kept by the parametrisation would keep them alive to the end.
+@pytest.mark.parametrize("make_error", [_unnamed_result, _rejected_input])
 def test_any_ruckig_failure_is_a_timing_error(
-    station: Station, monkeypatch: pytest.MonkeyPatch, error: Exception
+    station: Station, monkeypatch: pytest.MonkeyPatch, make_error: Callable[[], Exception]
 ) -> None:
     class Failing:
         def __init__(self, dof: int) -> None:
             del dof
 
         def calculate(self, *args: object) -> None:
-            raise error
+            raise make_error()
 
     monkeypatch.setattr(timing, "Ruckig", Failing)
     with pytest.raises(timing.TimingError, match="Ruckig could not time the joint move"):
