@@ -624,7 +624,7 @@ def _joint_path(
         bad_target = _joint_target_error(index, ins, ins.target, robot)
         if bad_target is not None:
             return None, [bad_target]
-        return _joint_line(state.q, ins.target.joints), []
+        return _joint_line(index, ins, state.q, ins.target.joints)
     flange = flange_target(ins.target, tool, frame)
     candidates = _candidates(robot, flange)
     if candidates.shape[0] == 0:
@@ -633,18 +633,34 @@ def _joint_path(
         candidates, found = _configured(index, ins, robot, candidates, ins.target.config)
         if candidates.shape[0] == 0:
             return None, found
-    return _joint_line(state.q, _nearest(candidates, state.q, state.opts.weights)), []
+    return _joint_line(index, ins, state.q, _nearest(candidates, state.q, state.opts.weights))
 
 
-def _joint_line(q0: FloatArray, q1: FloatArray, step: float = np.radians(2.0)) -> FloatArray:
-    """The joint-space straight line from ``q0`` to ``q1`` sampled every ``step`` rad (or finer)
-    on the axis that moves most: (S, 6). The box of joint limits is convex, so the line stays
-    inside the limits when both ends do; the samples serve path length and later collision
-    checks."""
-    count = int(max(np.ceil(np.max(np.abs(q1 - q0)) / step), 1))
-    fractions = np.linspace(0.0, 1.0, count + 1)[:, None]
+_JOINT_STEP_RAD = float(np.radians(2.0))
+"""Sampling of a joint move's straight joint line, on the axis that moves most."""
+
+
+def _joint_line(
+    index: int, ins: JointMove, q0: FloatArray, q1: FloatArray
+) -> tuple[FloatArray | None, list[Diagnostic]]:
+    """The joint-space straight line from ``q0`` to ``q1`` sampled every ``_JOINT_STEP_RAD``
+    (or finer) on the axis that moves most: (S, 6). The box of joint limits is convex, so the
+    line stays inside the limits when both ends do; the samples serve path length and later
+    collision checks. More than ``MAX_SAMPLES`` of them (an axis with limits of many turns
+    asked to turn hundreds of times) is an error on the move, not an allocation."""
+    turn = float(np.max(np.abs(q1 - q0)))
+    wanted = max(np.ceil(turn / _JOINT_STEP_RAD), 1.0)
+    if not wanted <= MAX_SAMPLES:
+        axis = int(np.argmax(np.abs(q1 - q0)))
+        msg = (
+            f"the joint move turns axis {axis + 1} by {np.degrees(turn):.6g}°: checking it every "
+            f"{wording.exact(np.degrees(_JOINT_STEP_RAD))}° needs {wanted:.4g} samples, more "
+            f"than the {MAX_SAMPLES} one move may have"
+        )
+        return None, [_error("too_long", msg, index, ins)]
+    fractions = np.linspace(0.0, 1.0, int(wanted) + 1)[:, None]
     line: FloatArray = q0 + fractions * (q1 - q0)
-    return line
+    return line, []
 
 
 def _nearest(candidates: FloatArray, q: FloatArray, weights: tuple[float, ...]) -> FloatArray:
@@ -718,12 +734,11 @@ def _linear_path(
             return None, [_unreachable(index, ins, robot, end)]
     # Sample the TCP line, not the flange line: with a long tool they differ.
     tcp_start, tcp_end = start @ tool.pose, end @ tool.pose
-    count_f = float(
-        segment_counts(tcp_start, tcp_end[None], state.opts.step_m, state.opts.step_rad)[0]
-    )
-    if not count_f <= MAX_SAMPLES:
-        return None, [_too_long(index, ins, tcp_start, tcp_end, count_f, state.opts)]
-    count = int(count_f)
+    opts = state.opts
+    wanted = float(segment_counts(tcp_start, tcp_end[None], opts.step_m, opts.step_rad)[0])
+    if not wanted <= MAX_SAMPLES:
+        return None, [_too_long(index, ins, tcp_start, tcp_end, wanted, opts)]
+    count = int(wanted)
     dist = float(pose_distance(tcp_start, tcp_end)[0])
     fractions = np.linspace(0.0, 1.0, count + 1)
     flanges = interpolate_poses(tcp_start, tcp_end, fractions) @ inv(tool.pose)
@@ -778,7 +793,8 @@ def _too_long(
     opts: ResolveOptions,
 ) -> Diagnostic:
     """A linear move that needs more samples than one check takes (a huge tool or frame)."""
-    dist, angle = (float(v) for v in pose_distance(start, end))
+    with np.errstate(over="ignore", invalid="ignore"):
+        dist, angle = (float(v) for v in pose_distance(start, end))
     msg = (
         f"the linear move is too long to check at the sampling step: "
         f"{wording.quantity(dist * 1000)} mm and {wording.quantity(np.degrees(angle))}° of TCP "

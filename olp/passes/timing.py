@@ -335,11 +335,12 @@ def _batch_lengths(
     sizes = np.array([len(path) for _, path, _ in motions], dtype=np.int64)
     joints = np.concatenate([path for _, path, _ in motions])
     tools = np.repeat(np.stack([tool for _, _, tool in motions]), sizes, axis=0)
-    positions = (robot.flange_poses(joints) @ tools)[:, :3, 3]
-    steps = np.linalg.norm(np.diff(positions, axis=0), axis=-1)
-    travel = np.concatenate([[0.0], np.cumsum(steps)])
-    ends = np.cumsum(sizes) - 1
-    lengths = travel[ends] - travel[ends - sizes + 1]
+    with np.errstate(over="ignore", invalid="ignore"):  # a tool 1e308 m long: inf, no warning
+        positions = (robot.flange_poses(joints) @ tools)[:, :3, 3]
+        steps = np.linalg.norm(np.diff(positions, axis=0), axis=-1)
+        travel = np.concatenate([[0.0], np.cumsum(steps)])
+        ends = np.cumsum(sizes) - 1
+        lengths = travel[ends] - travel[ends - sizes + 1]
     return {index: float(length) for (index, _, _), length in zip(motions, lengths, strict=True)}
 
 

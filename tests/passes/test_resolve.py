@@ -503,3 +503,32 @@ def test_a_touch_between_two_samples_counts() -> None:
     assert _closest(np.array([0.3, 0.2, 0.25]))[1] == pytest.approx(0.2 - 0.05**2 / (8 * 0.15))
     assert np.min(_closest(np.array([0.2, 0.1, -0.1, -0.2]))) == 0.0  # a crossing
     assert np.all(_closest(np.array([0.3, 0.3001, 0.3002])) == [0.3, 0.3001, 0.3002])
+
+
+def test_a_joint_move_of_hundreds_of_turns_is_too_long(station: Station) -> None:
+    """An axis with limits of many turns (an endless axis given as ±1e8°) asked to turn 1e8°
+    made 25 million samples (1.2 GB) and a MemoryError in the collision check."""
+    import dataclasses
+
+    from olp.passes.sampling import MAX_SAMPLES
+    from olp.station.model import JointLimits
+
+    limits = station.robot.limits
+    endless = JointLimits(
+        lower=np.concatenate([limits.lower[:5], [np.radians(-1e8)]]),
+        upper=np.concatenate([limits.upper[:5], [np.radians(1e8)]]),
+        velocity=limits.velocity,
+        acceleration=limits.acceleration,
+        jerk=limits.jerk,
+    )
+    cell = dataclasses.replace(station, robot=dataclasses.replace(station.robot, limits=endless))
+    turns = 2 * MAX_SAMPLES / 180  # twice as many 2° samples as a move may have
+    found = resolve(
+        ir.Program(
+            name="t",
+            instructions=[_ptp([0, -90, 90, 0, 30, 0]), _ptp([0, -90, 90, 0, 30, 360 * turns], 2)],
+        ),
+        cell,
+    ).diagnostics
+    assert [(d.kind, d.span.line) for d in found if d.span] == [("too_long", 2)]
+    assert "axis 6" in found[0].message

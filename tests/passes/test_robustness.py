@@ -45,3 +45,24 @@ def test_a_tiny_krl_joint_speed_is_a_timing_error_on_the_ptp(
         "DEF slow()\n$VEL_AXIS[1] = 0.000001\nPTP {A1 10,A2 -90,A3 90,A4 0,A5 30,A6 0}\nEND\n"
     )
     assert _errors(station, program) == [("timing", 3)]
+
+
+def _fuzz_module():  # type: ignore[no-untyped-def]
+    """benchmarks/fuzz_passes.py, the long-run fuzzer, loaded by path (not a package)."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(
+        "fuzz_passes", REPO / "benchmarks" / "fuzz_passes.py"
+    )
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_absurd_programs_give_diagnostics_not_exceptions(seed: int) -> None:
+    """A short seeded run of the fuzzer (``python -m benchmarks.fuzz_passes`` runs long)."""
+    crashes: list[str] = []
+    _fuzz_module().run(15, seed, lambda k, text: crashes.append(f"program {k}: {text}"))
+    assert crashes == []
