@@ -9,8 +9,9 @@ Today it walks by index. The old function is kept below and swapped in for the r
     python -m benchmarks.resolve_comments [--comments N] [--reference-comments R]
 
 The reference runs at R and R / 2 comments (its time grows ~4x per doubling); today's code at N
-and N / 10. Prints ``name: value unit`` lines; ``*_scaling`` is the time ratio of a 10x (or 2x)
-larger program: ~10 (or ~2) is linear, ~100 (or ~4) quadratic.
+and N / 10. The collision check and the timing pass, which walk the same steps, are measured at
+N and N / 10 too. Prints ``name: value unit`` lines; ``*_scaling`` is the time ratio of a 10x
+(or 2x) larger program: ~10 (or ~2) is linear, ~100 (or ~4) quadratic.
 """
 
 from __future__ import annotations
@@ -63,6 +64,22 @@ def _seconds(station: Station, comments: int) -> float:
     return elapsed
 
 
+def _later_passes(station: Station, comments: int) -> tuple[float, float]:
+    """Seconds of the collision check and of the timing pass on the resolved program."""
+    from olp.passes.collide import CollisionOptions, check_collisions
+    from olp.passes.timing import time_program
+
+    compiled = resolve_module.resolve(program(comments), station)
+    start = time.perf_counter()
+    found = check_collisions(compiled, CollisionOptions())
+    collide = time.perf_counter() - start
+    start = time.perf_counter()
+    timed = time_program(compiled)
+    timing = time.perf_counter() - start
+    assert not found and timed.ok
+    return collide, timing
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--comments", type=int, default=200_000)
@@ -79,11 +96,20 @@ def main() -> None:
     finally:
         resolve_module._linear_run = current
     exponent = np.log2(old / old_half)
+    _later_passes(station, 10)  # imports and first-call set-up out of the figures
+    (collide, timing), (collide_small, timing_small) = (
+        _later_passes(station, n),
+        _later_passes(station, n // 10),
+    )
     print(f"resolve_comments_seconds: {today:.3f} s ({n} comments)")
     print(f"resolve_comments_scaling: {today / today_small:.1f} x ({n // 10} -> {n} comments)")
     print(f"resolve_comments_old_seconds: {old:.3f} s ({r} comments)")
     print(f"resolve_comments_old_scaling: {old / old_half:.1f} x ({r // 2} -> {r} comments)")
     print(f"resolve_comments_speedup: {old / today_ref:.1f} x (old / today at {r} comments)")
+    print(f"collide_comments_seconds: {collide:.3f} s ({n} comments)")
+    print(f"collide_comments_scaling: {collide / collide_small:.1f} x ({n // 10} -> {n} comments)")
+    print(f"timing_comments_seconds: {timing:.3f} s ({n} comments)")
+    print(f"timing_comments_scaling: {timing / timing_small:.1f} x ({n // 10} -> {n} comments)")
     # The old path at n comments, extrapolated with its measured growth (not run: minutes).
     print(f"resolve_comments_old_extrapolated: {old * (n / r) ** exponent:.1f} s ({n} comments)")
 
