@@ -87,3 +87,27 @@ def singularity_distances(kinematics: object, joints: ArrayLike) -> Singularitie
     if measure is None:
         return None
     return measure(kinematics, np.asarray(joints, dtype=np.float64))
+
+
+BRANCH_BITS: dict[str, int] = {"wrist": 1, "elbow": 2, "shoulder": 4}
+"""The bit of each singularity in an IK branch index (``4·shoulder + 2·elbow + wrist``, the
+layout of :mod:`olp.kinematics.opw` and :mod:`olp.kinematics.ur`): on a singularity the two
+branches that differ in its bit meet."""
+
+ON_SINGULARITY = 1e-9
+"""A distance (sine, or metres) this small is on the singularity: there the IK's split of the
+free joints comes from rounding noise (a pose known to 1e-16 fixes axis 4 next to the wrist
+singularity only to 1e-16 / sin(theta5))."""
+
+
+def meeting_branches(kinematics: object, joints: ArrayLike, branch: int) -> list[int]:
+    """``branch`` and every branch that meets it at controller joints (6,) rad: those with the
+    bit of each singularity the joints are on (within :data:`ON_SINGULARITY`) flipped."""
+    found = singularity_distances(kinematics, np.asarray(joints, dtype=np.float64)[None])
+    if found is None:
+        return [branch]
+    out = [branch]
+    for name, bit in BRANCH_BITS.items():
+        if abs(float(getattr(found, name)[0])) <= ON_SINGULARITY:
+            out += [b ^ bit for b in out]
+    return out

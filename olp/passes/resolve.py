@@ -5,7 +5,8 @@
 * A Cartesian target of a joint move takes the IK solution (any branch, any ±360° turn variant
   inside the limits) nearest to the previous joints.
 * A linear move must stay in one IK branch: the straight TCP line is sampled (``step_m``,
-  ``step_rad``), solved in the branch of the start joints and unwrapped continuously. Leaving the
+  ``step_rad``), solved in the branch of the start joints (on a singularity, the branch that
+  meets it there and continues it) and unwrapped continuously. Leaving the
   workspace, a joint limit, or a joint jump between samples (a singularity or a configuration
   flip) is an error on that instruction; so is a move that needs more samples than one check
   takes (:data:`olp.passes.sampling.MAX_SAMPLES`), counted before any is made. A path that
@@ -42,7 +43,7 @@ from olp.ir import (
     is_motion,
 )
 from olp.kinematics.base import turn_variants
-from olp.kinematics.singularity import singularity_distances
+from olp.kinematics.singularity import ON_SINGULARITY, meeting_branches, singularity_distances
 from olp.passes import wording
 from olp.passes.sampling import MAX_SAMPLES, SegmentSamples, sample_segments, segment_counts
 from olp.station.model import Robot, Station
@@ -299,7 +300,7 @@ def _batch_path(chunk: list[tuple[LinearMove, Tool, Frame]], state: _State) -> _
         return _Batch(state.q[None], None, 0, 0)
     samples = sample_segments(start, targets[:fit], opts.step_m, opts.step_rad)
     flanges = samples.poses @ inv(tool_pose)
-    sols = robot.solve(flanges, seed=state.q)[:, robot.branch_of(state.q), :]
+    sols = _branch_path(robot, state.q, robot.solve(flanges, seed=state.q))
     path = np.vstack([state.q[None], _unwrap(state.q, sols)])
     with np.errstate(invalid="ignore"):
         invalid = ~np.all(np.isfinite(path[1:]), axis=-1)
@@ -463,7 +464,9 @@ def _singular_warnings(
                 distance=wording.quantity(amount * 1000, 3),
                 place=found.shoulder_place,
             )
-            also = "" if hi - lo == 1 else f"; moves {first + lo + 1}-{first + hi - 1} too"
+            also = {1: "", 2: f"; move {first + lo + 1} too"}.get(
+                hi - lo, f"; moves {first + lo + 1}-{first + hi - 1} too"
+            )
             out.append(
                 Diagnostic(
                     "warning",
@@ -742,8 +745,7 @@ def _linear_path(
     dist = float(pose_distance(tcp_start, tcp_end)[0])
     fractions = np.linspace(0.0, 1.0, count + 1)
     flanges = interpolate_poses(tcp_start, tcp_end, fractions) @ inv(tool.pose)
-    branch = robot.branch_of(state.q)
-    sols = robot.solve(flanges, seed=state.q)[:, branch, :]
+    sols = _branch_path(robot, state.q, robot.solve(flanges, seed=state.q))
     if np.any(~np.isfinite(sols)):
         first = int(np.argmax(~np.all(np.isfinite(sols), axis=-1)))
         msg = (
@@ -804,6 +806,54 @@ def _too_long(
     )
     hint = "check the tool and frame of the move (units: mm in the station)"
     return _error("too_long", msg, index, ins, hint=hint)
+
+
+def _branch_path(robot: Robot, q: FloatArray, solutions: FloatArray) -> FloatArray:
+    """The IK solutions (S, 6) along a path, from all branches (S, B, 6), that a linear move
+    from joints ``q`` follows: the branch ``q`` lies in. Where ``q`` is exactly on a
+    singularity, the branches that meet there are all continuous with it, and the path takes
+    the one whose first solution is nearest ``q`` (from HOME, A5 = 0, a line up needs the
+    other wrist branch than a line down). Samples exactly on the wrist singularity get their
+    axis 4 / axis 6 split from the sample before (:func:`_settle_wrist`)."""
+    options = meeting_branches(robot.kinematics, q, robot.branch_of(q))
+    first = solutions[0, options]
+    with np.errstate(invalid="ignore"):
+        gap = np.sum(((first - q + np.pi) % (2 * np.pi) - np.pi) ** 2, axis=-1)
+    branch = options[int(np.argmin(np.where(np.isfinite(gap), gap, np.inf)))]
+    return _settle_wrist(robot, q, solutions[:, branch, :])
+
+
+def _settle_wrist(robot: Robot, q0: FloatArray, sols: FloatArray) -> FloatArray:
+    """IK solutions (S, 6) of one branch with every sample exactly on the wrist singularity
+    (axes 4 and 6 in line: the pose fixes only their sum or difference, and the IK's split is
+    rounding noise) re-split by continuity: axis 4 as in the sample before (``q0`` before the
+    first), axis 6 taking the rest, with the sign of the combination that reproduces the
+    sample's pose. Other samples are returned as they are."""
+    found = singularity_distances(robot.kinematics, sols)
+    if found is None:
+        return sols
+    with np.errstate(invalid="ignore"):
+        rows = np.flatnonzero(np.abs(found.wrist) <= ON_SINGULARITY)
+    if rows.size == 0:
+        return sols
+    out = sols.copy()
+    for row in rows.tolist():  # rare: a sample exactly on the singularity
+        before = q0 if row == 0 else out[row - 1]
+        out[row] = _resplit(robot, out[row], float(before[3]))
+    return out
+
+
+def _resplit(robot: Robot, q: FloatArray, axis4: float) -> FloatArray:
+    """Joints ``q`` (6,) on the wrist singularity with axis 4 moved to ``axis4`` and axis 6
+    turned by the same angle, or the opposite one, whichever keeps the flange pose."""
+    pose = robot.flange_poses(q)
+    turn = axis4 - q[3]
+    for sign in (-1.0, 1.0):
+        moved = q.copy()
+        moved[3], moved[5] = axis4, q[5] + sign * turn
+        if np.allclose(robot.flange_poses(moved), pose, atol=1e-9):
+            return moved
+    return q
 
 
 def _unwrap(q0: FloatArray, sols: FloatArray) -> FloatArray:

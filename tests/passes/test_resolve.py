@@ -532,3 +532,40 @@ def test_a_joint_move_of_hundreds_of_turns_is_too_long(station: Station) -> None
     ).diagnostics
     assert [(d.kind, d.span.line) for d in found if d.span] == [("too_long", 2)]
     assert "axis 6" in found[0].message
+
+
+def test_consecutive_singular_lins_are_reported_together(station: Station) -> None:
+    """A LIN ending at HOME's wrist singularity and one starting there: one warning."""
+    above = _down(station, HOME, -0.02, 2)  # 20 mm up: A5 leaves 0
+    back = _lin_to_joints(station, HOME, 3)
+    (found,) = _warnings(station, _ptp(HOME), above, back)
+    assert found[:2] == ("singularity", 2)
+    assert "linear move 1 starts in the wrist singularity" in found[2]
+    assert found[2].endswith("; move 2 too")
+
+
+@pytest.mark.parametrize("metres", [0.02, -0.02])
+def test_a_lin_from_and_back_to_an_exactly_singular_wrist_stays_continuous(
+    station: Station, metres: float
+) -> None:
+    """From A5 = 0 exactly (A4 = 0) up or down, and back to the same pose as a program computes
+    it (with rounding noise: through a frame and back). Both ways the path is continuous: from
+    the singular start the move takes the wrist branch continuous with it (up needs the other
+    one than down: was a 180° "singularity" jump), and on arrival the IK's split of A4 / A6,
+    rounding noise there (here 18° to 34°), is replaced by the continuous one (was a jump)."""
+    from olp.geometry import rotation_from_zyx
+
+    start = [20, -80, 100, 0, 0, 0]
+    pose = station.robot.flange_poses(np.radians(start))
+    frame = np.eye(4)
+    frame[:3, :3] = rotation_from_zyx(0.3, -1.1, 2.0)
+    noisy = pose @ frame @ np.linalg.inv(frame)
+    away = ir.LinearMove(target=ir.CartesianTarget(pose=transl(0, 0, metres) @ pose), span=_span(2))
+    back = ir.LinearMove(target=ir.CartesianTarget(pose=noisy), span=_span(3))
+    compiled = resolve(ir.Program(name="t", instructions=[_ptp(start), away, back]), station)
+    assert [(d.severity, d.kind, d.span.line) for d in compiled.diagnostics if d.span] == [
+        ("warning", "singularity", 2)
+    ]
+    assert compiled.diagnostics[0].message.endswith("; move 2 too")
+    final = compiled.steps[2].joints
+    assert final is not None and np.allclose(final, np.radians(start), atol=1e-6)
