@@ -616,7 +616,9 @@ def _restart_at_target(
 def flange_target(target: CartesianTarget, tool: Tool, frame: Frame) -> FloatArray:
     """World pose (4, 4) of the flange that puts the tool's TCP on ``target`` in ``frame``."""
     assert tool.pose is not None and frame.pose is not None
-    return frame.pose @ target.pose @ inv(tool.pose)
+    with np.errstate(over="ignore", invalid="ignore"):  # 1e308 m poses: inf, then unreachable
+        flange: FloatArray = frame.pose @ target.pose @ inv(tool.pose)
+    return flange
 
 
 def _joint_path(

@@ -694,7 +694,12 @@ def _time_lines(context: _Context, units: Sequence[Unit]) -> tuple[list[Step], l
     once; returns the timed steps and the units left for the other timers (the rest, and the
     lines whose error bound exceeds ``line_tolerance``)."""
     opts, all_steps = context.options, context.compiled.steps
-    singles = [u for u in units if u.kind == "path" and len(u.indices) == 1]
+    # A move below MIN_PATH_SPEED goes to the chain timer, which reports it.
+    singles = [
+        u
+        for u in units
+        if u.kind == "path" and len(u.indices) == 1 and not _below_floor(all_steps[u.indices[0]])
+    ]
     if not opts.straight_lines or not singles:
         return [], list(units)
     paths = [all_steps[u.indices[0]].path for u in singles]
@@ -1038,6 +1043,15 @@ MIN_PATH_SPEED = 1e-150
 solver works with the squared path speed ``(v / rate)²``, rate up to ~10 m/rad: below this it
 would leave the normal float range (2.2e-308) and the time law would lose its digits, then
 vanish (measured: 1e-160 m/s timed 5e-7 off, 1e-300 m/s found no time law)."""
+
+
+def _below_floor(step: Step) -> bool:
+    """Whether a path move's programmed speed is below :data:`MIN_PATH_SPEED`."""
+    speed = step.instruction.speed if is_motion(step.instruction) else None
+    if speed is None:
+        return False
+    angular = np.inf if speed.angular is None else speed.angular
+    return bool(speed.linear < MIN_PATH_SPEED or angular < MIN_PATH_SPEED)
 
 
 def _too_slow(steps: Sequence[Step], linear: FloatArray, angular: FloatArray) -> Diagnostic | None:
