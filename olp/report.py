@@ -22,6 +22,7 @@ import numpy as np
 from olp.api import BuildResult
 from olp.errors import excerpt, line_of
 from olp.ir import is_motion
+from olp.passes.wording import quantity
 
 if TYPE_CHECKING:
     from numpy.typing import NDArray
@@ -91,7 +92,9 @@ def summary(result: BuildResult) -> str:
         ("reachability", _verdict(len(motions), len(resolved), errors)),
         (
             "cycle time",
-            f"{compiled.cycle_time:.2f} s ({_timing_note(compiled)})" if compiled.ok else "-",
+            f"{quantity(compiled.cycle_time, 2)} s ({_timing_note(compiled)})"
+            if compiled.ok
+            else "-",
         ),
         (
             "path length",
@@ -122,7 +125,7 @@ def timing_summary(compiled: CompiledProgram) -> str:
     rows = [
         ("program", f"{compiled.program.name} ({compiled.program.source})"),
         ("station", f"{compiled.station.name} ({compiled.station.robot.name})"),
-        ("cycle time", f"{compiled.cycle_time:.3f} s ({_timing_note(compiled)})"),
+        ("cycle time", f"{quantity(compiled.cycle_time, 3)} s ({_timing_note(compiled)})"),
         ("path length", f"{_path_length(compiled) * 1000:.1f} mm of TCP travel"),
     ]
     width = max(len(k) for k, _ in rows)
@@ -138,12 +141,18 @@ def timing_table(compiled: CompiledProgram) -> str:
             str(step.index),
             step.instruction.kind,
             f"{Path(step.instruction.span.file).name}:{step.instruction.span.line}",
-            f"{step.path_length * 1000:.2f}" if is_motion(step.instruction) else "",
-            f"{step.duration:.3f}",
+            quantity(step.path_length * 1000, 2) if is_motion(step.instruction) else "",
+            quantity(step.duration, 3),
         )
         for step in compiled.steps
     ]
-    total = ("", "total", "", f"{_path_length(compiled) * 1000:.2f}", f"{compiled.cycle_time:.3f}")
+    total = (
+        "",
+        "total",
+        "",
+        quantity(_path_length(compiled) * 1000, 2),
+        quantity(compiled.cycle_time, 3),
+    )
     return _columns([header, *rows, total], right=(0, 3, 4))
 
 
@@ -163,7 +172,7 @@ def sweep_table(
 
 
 def _seconds(value: float) -> str:
-    return "-" if not np.isfinite(value) else f"{value:.2f}"
+    return "-" if not np.isfinite(value) else quantity(value, 2)
 
 
 def _columns(rows: Sequence[Sequence[str]], right: tuple[int, ...]) -> str:

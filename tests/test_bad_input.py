@@ -128,6 +128,13 @@ CASES: dict[str, Case] = {
         "robot:\n  model: ../../etc/passwd\n", 2, "unknown robot model '../../etc/passwd'"
     ),
     "station: empty file": station("", 1, "robot"),
+    "station: joint ranges of a million degrees": station(
+        ROBOT
+        + "  limits:\n    position_deg: [[-170, 170], [-190, 45], [-120, 156], [-1e6, 1e6],"
+        + " [-120, 120], [-1e6, 1e6]]\n",
+        4,
+        "combinations of turns",
+    ),
     # ---- KRL programs -----------------------------------------------------------------------
     "krl: syntax error": krl("LIN {X 500,Y 0 Z 500}", 2, r"prog\.src:3:16: parse error"),
     "krl: unknown statement": krl("FOO BAR", 2, r"prog\.src:3:5: parse error"),

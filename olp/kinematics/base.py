@@ -156,7 +156,7 @@ def wrap_joints(joints: ArrayLike) -> FloatArray:
     return np.minimum(x, math.pi, out=x)
 
 
-def _turn_shifts(lower: float, upper: float) -> list[float]:
+def turn_shifts(lower: float, upper: float) -> list[float]:
     """Multiples of 2 pi that move some value in (-pi, pi] into [lower, upper], 0 first."""
     lo = math.ceil((lower - math.pi) / _TWO_PI)
     hi = math.floor((upper + math.pi) / _TWO_PI)
@@ -193,7 +193,7 @@ def turn_variants(
             f"got {lo.shape}, {hi.shape}"
         )
     shifts = np.array(
-        list(itertools.product(*(_turn_shifts(a, b) for a, b in zip(lo, hi, strict=True))))
+        list(itertools.product(*(turn_shifts(a, b) for a, b in zip(lo, hi, strict=True))))
     ).reshape(-1, dof)
     variants: FloatArray = base[..., None, :] + shifts
     with np.errstate(invalid="ignore"):

@@ -58,6 +58,7 @@ from olp.diagnostics import Diagnostic
 from olp.errors import UsageError
 from olp.geometry import inv
 from olp.ir import FLANGE, Tool, is_motion
+from olp.passes.wording import percent
 
 if TYPE_CHECKING:
     from olp.collision.advance import Hit, Unresolved
@@ -470,8 +471,8 @@ def _check_run(
 def _unresolved(run: _Run, first: str, second: str, exc: Unresolved) -> Diagnostic:
     step = run.steps[exc.where.motion]
     message = (
-        f"{first} against {second} cannot be checked from {exc.where.fraction:.0%} of the move "
-        f"on: {exc.reason}"
+        f"{first} against {second} cannot be checked from {percent(exc.where.fraction)} of "
+        f"the move on: {exc.reason}"
     )
     return Diagnostic(
         "error",
@@ -516,11 +517,11 @@ def _diagnostic(items: Sequence[_Found], clearance: float) -> Diagnostic:
     what = "self-collision: " if first.kind == "self_collision" else ""
     pair = f"{what}{first.first} hits {first.second}"
     near = f" (closer than {clearance * 1000:.1f} mm)" if hit.distance >= 0 else ""
-    text = f"{pair} at {hit.fraction:.0%} of the move{near}"
+    text = f"{pair} at {percent(hit.fraction)} of the move{near}"
     if len(items) > 1:
         text = (
             f"moves {first.step.index}-{items[-1].step.index}: {pair}{near} "
-            f"(first at {hit.fraction:.0%} of move {first.step.index})"
+            f"(first at {percent(hit.fraction)} of move {first.step.index})"
         )
     return Diagnostic(
         "error",

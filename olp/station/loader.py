@@ -56,7 +56,7 @@ from olp import vendors
 from olp.errors import StationError
 from olp.geometry import pose_from, rotation_from_quaternion, rotation_from_zyx
 from olp.ir import Frame, Tool
-from olp.kinematics.base import JointCoupling, Kinematics
+from olp.kinematics.base import JointCoupling, Kinematics, turn_shifts
 from olp.kinematics.models import ChainKinematics, OPWKinematics, URKinematics, default_seeds
 from olp.kinematics.opw import OPWParameters
 from olp.kinematics.ur import URParameters
@@ -259,7 +259,22 @@ def _position_limits(
     for i, (lower, upper) in enumerate(pairs):
         if lower >= upper:
             raise src.error((*path, i), "lower limit must be below upper limit")
+    turns = [len(turn_shifts(lower, upper)) for lower, upper in pairs]
+    if math.prod(turns) > MAX_TURN_COMBINATIONS:
+        raise src.error(
+            path,
+            f"these ranges let the axes take {math.prod(turns):,} combinations of turns "
+            f"(per axis: {', '.join(map(str, turns))}); olp considers every one for each target, "
+            f"and allows at most {MAX_TURN_COMBINATIONS:,}",
+        )
     return pairs[:, 0], pairs[:, 1]
+
+
+MAX_TURN_COMBINATIONS = 4096
+"""Most joint-turn combinations the position limits may allow (olp's bound): inverse kinematics
+lists every ``q + 2 pi m`` inside the limits for each target, so a joint of ±1e8° meant half a
+million variants (400 MB) per target. 4096 admits every real arm (the most among the bundled
+robots: 729, six UR axes of ±360°) and, say, two axes of ±5000°."""
 
 
 @dataclass(frozen=True, slots=True, eq=False)

@@ -145,3 +145,11 @@ def test_sweep_progress_only_on_a_terminal_and_not_quiet(
         assert "timing speeds" not in err
     else:
         assert "timing speeds 1/3" in err and "timing speeds 3/3" in err
+
+
+def test_a_huge_dwell_is_printed_short(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    program = tmp_path / "w.src"
+    program.write_text("DEF w( )\nPTP {A1 0,A2 -90,A3 90,A4 0,A5 45,A6 0}\nWAIT SEC 1E300\nEND\n")
+    assert _olp_time(CELL, program) == 0
+    out = capsys.readouterr().out
+    assert "1e+300" in out and max(len(line) for line in out.splitlines()) < 120
