@@ -76,7 +76,9 @@ def _dls(
         error = pin.log6(error_pose).vector
         if np.linalg.norm(error) < opts.tolerance:
             return q, True
-        jac = pin.computeFrameJacobian(model, data, q, frame_id, pin.LOCAL)
+        # (6, nv): pinocchio hands a one-joint chain's Jacobian back as a vector
+        jac = np.asarray(pin.computeFrameJacobian(model, data, q, frame_id, pin.LOCAL))
+        jac = jac.reshape(6, model.nv)
         # pinocchio's example writes J = -Jlog6(E^-1)·J and dq = -J^T(...)e: the signs cancel.
         jac = pin.Jlog6(error_pose.inverse()) @ jac
         step = jac.T @ np.linalg.solve(jac @ jac.T + opts.damping * eye, error)

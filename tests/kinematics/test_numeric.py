@@ -222,3 +222,13 @@ def test_dh_table_robot_in_a_station(tmp_path: Path) -> None:
     valid = ~np.isnan(sols).any(axis=-1)
     dist, _ = pose_distance(robot.flange_poses(sols[valid]), robot.flange_poses(q))
     assert valid.any() and dist.max() < 1e-9
+
+
+def test_a_one_joint_chain_solves_without_a_crash() -> None:
+    """pinocchio returns a one-joint chain's Jacobian as a vector; the solver must not pass a
+    scalar step on (it raised Boost.Python.ArgumentError)."""
+    model = build_dh_model([0.1], [0.0], [0.3])
+    chain = ChainKinematics(model, np.zeros((1, 1)), JointCoupling.identity(1))
+    target = chain.forward(np.array([[0.4]]))
+    solutions = chain.inverse(target)
+    assert np.any(np.all(np.abs(solutions - 0.4) < 1e-6, axis=-1))
