@@ -38,7 +38,7 @@ from olp.errors import UsageError
 from olp.ir import is_motion
 
 if TYPE_CHECKING:
-    from olp.passes.resolve import CompiledProgram
+    from olp.compiled import CompiledProgram
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]

@@ -82,6 +82,7 @@ import itertools
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from types import MappingProxyType
+from typing import TYPE_CHECKING
 
 import numpy as np
 import toppra
@@ -93,12 +94,15 @@ from scipy.interpolate import CubicSpline, PPoly
 from toppra.algorithm.algorithm import ParameterizationAlgorithm
 from toppra.solverwrapper.cy_seidel_solverwrapper import seidelWrapper
 
+from olp.compiled import CompiledProgram, Step
 from olp.diagnostics import Diagnostic
 from olp.geometry import rotation_log
 from olp.ir import Call, CircularMove, Comment, Instruction, JointMove, LinearMove, Wait, is_motion
-from olp.passes.resolve import CompiledProgram, Step
 from olp.station.model import JointLimits, Robot
 from olp.trajectory import JerkProfile, LineTimeLaw, PathTimeLaw, Segment
+
+if TYPE_CHECKING:
+    from olp.passes.pipeline import BuildOptions
 
 FloatArray = NDArray[np.float64]
 
@@ -1697,3 +1701,11 @@ def speed_sweep(
     rest = float(sum(steps[i].duration for u in fixed for i in u.indices))
     table: FloatArray = parts[0][:, None] + parts[1][None, :] + rest
     return table
+
+
+def timing_pass(compiled: CompiledProgram, options: BuildOptions) -> CompiledProgram:
+    """The timing pass: :func:`time_program` with ``options.other_times`` and
+    ``options.timing``; a program with errors is not timed (nothing will run)."""
+    if not compiled.ok:
+        return compiled
+    return time_program(compiled, options.other_times, options.timing)

@@ -30,11 +30,12 @@ import pytest
 from scipy.interpolate import CubicSpline
 
 from olp import ir
+from olp.compiled import CompiledProgram, Step
 from olp.geometry import rotation_log, rotz
 from olp.kinematics.opw import OPWParameters
 from olp.kinematics.pinocchio_model import TOOL0, build_model
 from olp.passes import timing
-from olp.passes.resolve import CompiledProgram, ResolveOptions, Step, resolve
+from olp.passes.resolve import ResolveOptions, resolve
 from olp.passes.timing import (
     DEFAULT_TIMES,
     ChainGeometry,
