@@ -5,27 +5,36 @@ unresolved form (one empty step per instruction), the resolve pass fills joints,
 frames, checks append diagnostics, the timing pass fills durations and trajectories. Posts render
 from it. Its own module, so that the passes, the trajectory sampler and the posts can name it
 without importing one another.
+
+A dense toolpath (:class:`olp.ir.LinearPath`) is compiled as dense too: its rows are a
+:class:`PathBlock` (arrays: end joints, the sampled joint path, durations, ...) and the program's
+``steps`` a :class:`StepBlocks`, a sequence of steps that makes the :class:`Step` of a row only
+when asked for it. Code that walks ``compiled.steps`` sees one step per instruction either way;
+passes that work on arrays take ``steps.blocks``.
 """
 
 from __future__ import annotations
 
+import bisect
 import dataclasses
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, overload
 
 import numpy as np
 from numpy.typing import NDArray
 
 from olp.diagnostics import Diagnostic, has_errors
-from olp.ir import Frame, Instruction, Program, Tool, is_motion
+from olp.ir import Frame, Instruction, LinearPath, Program, Tool, is_motion
 
 if TYPE_CHECKING:
     from collections.abc import Iterable
 
     from olp.station.model import Station
-    from olp.trajectory import Segment
+    from olp.trajectory import Segment, TimeLaw
 
 FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -51,13 +60,138 @@ class Step:
 
 
 @dataclass(frozen=True, slots=True, eq=False)
+class PathBlock:
+    """The compiled rows of a :class:`~olp.ir.LinearPath`: row ``k`` is instruction
+    ``start + k``.
+
+    ``tool``/``frame``: resolved (None: not found in the station); ``joints`` (N, dof) rad: the
+    joints at the end of each row; ``path`` (S + 1, dof) rad: the sampled joint path of all rows
+    from the joints before row 0 (row 0 of ``path``); ``ends`` (N,): the row of ``path`` where
+    each row ends (row ``k`` runs from ``ends[k - 1]``, or 0, to ``ends[k]``). None until the
+    resolve pass resolved the block (a block is resolved as a whole: rows that fail are split
+    off into ordinary steps). ``durations`` and ``lengths`` (N,): seconds and metres of TCP
+    travel per row (zeros until timed); ``trajectories``: per-row time laws, or None.
+    """
+
+    start: int
+    node: LinearPath
+    tool: Tool | None = None
+    frame: Frame | None = None
+    joints: FloatArray | None = None
+    path: FloatArray | None = None
+    ends: IntArray | None = None
+    durations: FloatArray | None = None
+    lengths: FloatArray | None = None
+    trajectories: RowTrajectories | None = None
+
+    def __len__(self) -> int:
+        return len(self.node)
+
+    @property
+    def stop(self) -> int:
+        """The instruction index after the block's last row."""
+        return self.start + len(self.node)
+
+    def row_path(self, k: int) -> FloatArray | None:
+        """Row ``k``'s joint path (S_k + 1, dof), its start included, or None."""
+        if self.path is None or self.ends is None:
+            return None
+        lo = 0 if k == 0 else int(self.ends[k - 1])
+        return self.path[lo : int(self.ends[k]) + 1]
+
+    def step(self, k: int) -> Step:
+        """Row ``k`` as an ordinary :class:`Step`."""
+        trajectory = None if self.trajectories is None else self.trajectories.segment(k)
+        return Step(
+            index=self.start + k,
+            instruction=self.node.move(k),
+            joints=None if self.joints is None else self.joints[k],
+            path=self.row_path(k),
+            tool=self.tool,
+            frame=self.frame,
+            duration=0.0 if self.durations is None else float(self.durations[k]),
+            path_length=0.0 if self.lengths is None else float(self.lengths[k]),
+            trajectory=trajectory,
+        )
+
+
+class RowTrajectories:
+    """The time laws of a block's rows: row ``k`` is :meth:`segment` ``(k)``, a window of a law
+    (several rows share one law where they are blended into a chain)."""
+
+    def __init__(self, laws: Sequence[TimeLaw], law: IntArray, start: FloatArray, end: FloatArray):
+        self.laws, self.law, self.start, self.end = laws, law, start, end
+
+    def segment(self, k: int) -> Segment:
+        from olp.trajectory import Segment
+
+        return Segment(self.laws[int(self.law[k])], float(self.start[k]), float(self.end[k]))
+
+
+Item = Step | PathBlock
+"""What a dense program's steps hold: a step, or a block of a toolpath's rows."""
+
+
+class StepBlocks(Sequence[Step]):
+    """The steps of a program with dense toolpaths: ordinary steps and :class:`PathBlock`\\ s
+    (``blocks``), read as one :class:`Step` per instruction, each made when asked for."""
+
+    def __init__(self, blocks: Sequence[Item]) -> None:
+        self.blocks: tuple[Item, ...] = tuple(blocks)
+        self._starts = [b.start if isinstance(b, PathBlock) else b.index for b in self.blocks]
+        last = self.blocks[-1] if self.blocks else None
+        self._len = (
+            0 if last is None else (last.stop if isinstance(last, PathBlock) else last.index + 1)
+        )
+
+    def __len__(self) -> int:
+        return self._len
+
+    @overload
+    def __getitem__(self, index: int) -> Step: ...
+
+    @overload
+    def __getitem__(self, index: slice) -> Sequence[Step]: ...
+
+    def __getitem__(self, index: int | slice) -> Step | Sequence[Step]:
+        if isinstance(index, slice):
+            return [self[i] for i in range(*index.indices(self._len))]
+        if index < 0:
+            index += self._len
+        if not 0 <= index < self._len:
+            raise IndexError(index)
+        item = self.blocks[bisect.bisect_right(self._starts, index) - 1]
+        return item.step(index - item.start) if isinstance(item, PathBlock) else item
+
+    def __iter__(self) -> Iterator[Step]:
+        for item in self.blocks:
+            if isinstance(item, PathBlock):
+                for k in range(len(item)):
+                    yield item.step(k)
+            else:
+                yield item
+
+
+def make_steps(items: Sequence[Item]) -> tuple[Step, ...] | StepBlocks:
+    """Steps from ordinary steps and blocks: a plain tuple when there is no block."""
+    if any(isinstance(item, PathBlock) for item in items):
+        return StepBlocks(items)
+    return tuple(item for item in items if isinstance(item, Step))
+
+
+def items_of(steps: Sequence[Step]) -> tuple[Item, ...]:
+    """The steps and blocks behind ``steps`` (a :class:`StepBlocks` or any sequence of steps)."""
+    return steps.blocks if isinstance(steps, StepBlocks) else tuple(steps)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
 class CompiledProgram:
     """A program resolved on a station: steps (one per instruction) and diagnostics."""
 
     program: Program
     station: Station
     start_joints: FloatArray
-    steps: tuple[Step, ...]
+    steps: Sequence[Step]
     diagnostics: tuple[Diagnostic, ...] = field(default=())
 
     @property
@@ -68,7 +202,13 @@ class CompiledProgram:
     @property
     def cycle_time(self) -> float:
         """Total estimated time, seconds."""
-        return float(sum(s.duration for s in self.steps))
+        total = 0.0
+        for item in items_of(self.steps):
+            if isinstance(item, PathBlock):
+                total += 0.0 if item.durations is None else float(np.sum(item.durations))
+            else:
+                total += item.duration
+        return total
 
     def motion_steps(self) -> list[Step]:
         return [s for s in self.steps if is_motion(s.instruction)]
@@ -77,8 +217,16 @@ class CompiledProgram:
     def start(cls, program: Program, station: Station) -> CompiledProgram:
         """``program`` before any pass: one empty step per instruction, starting at the
         robot's home joints."""
-        steps = tuple(Step(index=i, instruction=ins) for i, ins in enumerate(program))
-        return cls(program, station, station.robot.home.copy(), steps)
+        items: list[Item] = []
+        index = 0
+        for node in program.instructions:
+            if isinstance(node, LinearPath):
+                items.append(PathBlock(index, node))
+                index += len(node)
+            else:
+                items.append(Step(index=index, instruction=node))
+                index += 1
+        return cls(program, station, station.robot.home.copy(), make_steps(items))
 
     def with_diagnostics(self, found: Iterable[Diagnostic]) -> CompiledProgram:
         """A copy with ``found`` appended to the diagnostics."""

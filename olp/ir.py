@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal, TypeAlias, TypeGuard
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from olp.span import GENERATED, SourceSpan
 
@@ -33,6 +33,7 @@ if TYPE_CHECKING:
     from typing import Self
 
 FloatArray: TypeAlias = NDArray[np.float64]
+IntArray: TypeAlias = NDArray[np.int64]
 
 
 class IRError(ValueError):
@@ -121,6 +122,16 @@ class CartesianTarget:
         pose = _frozen_array(self.pose, (4, 4), "CartesianTarget.pose")
         _check_rigid(pose, "CartesianTarget.pose")
         object.__setattr__(self, "pose", pose)
+
+    @classmethod
+    def trusted(cls, pose: FloatArray, name: str | None = None) -> CartesianTarget:
+        """A target from a pose (4, 4) already validated (a row of a :class:`LinearPath`, checked
+        with all its rows at once): no second check per pose."""
+        target = object.__new__(cls)
+        object.__setattr__(target, "pose", pose)
+        object.__setattr__(target, "config", None)
+        object.__setattr__(target, "name", name)
+        return target
 
 
 Target: TypeAlias = JointTarget | CartesianTarget
@@ -372,12 +383,162 @@ Instruction: TypeAlias = (
 MOTION_TYPES = (JointMove, LinearMove, CircularMove)
 
 
+@_array_eq
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class LinearPath:
+    """N consecutive linear moves as arrays, with one tool and one frame: the dense form of a CAM
+    toolpath (a million points are a few arrays, not a million objects).
+
+    ``poses`` (N, 4, 4) m: the TCP in ``frame``, one row per move's target; ``speeds`` (N,) m/s;
+    ``zones`` (N,) m (0: a fine stop); ``lines`` (N,) the 1-based source line of each row in
+    ``source``, and ``widths`` (N,) its length in characters (for a located message), or None;
+    ``labels`` (N,) integer target names (a CSV index column), or None; ``angular`` the TCP
+    orientation speed limit of every row, rad/s, or None.
+
+    All rows are validated at once when the node is made (finite, rigid rotations, speeds > 0,
+    zones >= 0). Row ``k`` as an ordinary instruction is :meth:`move` ``(k)``; iterating the node
+    (or a :class:`Program` holding it) yields those, made on demand.
+    """
+
+    poses: FloatArray
+    speeds: FloatArray
+    zones: FloatArray
+    lines: IntArray
+    tool: Tool = field(default_factory=lambda: FLANGE)
+    frame: Frame = field(default_factory=lambda: WORLD)
+    angular: float | None = None
+    source: str = "<memory>"
+    widths: IntArray | None = None
+    labels: IntArray | None = None
+    kind: Literal["linear_path"] = field(default="linear_path", init=False)
+
+    def __post_init__(self) -> None:
+        poses = _frozen_array(self.poses, None, "LinearPath.poses")
+        if poses.ndim != 3 or poses.shape[1:] != (4, 4) or poses.shape[0] == 0:
+            raise IRError(f"LinearPath.poses: expected shape (N, 4, 4), N >= 1, got {poses.shape}")
+        _check_rigid_rows(poses, "LinearPath.poses")
+        n = poses.shape[0]
+        speeds = _frozen_array(self.speeds, (n,), "LinearPath.speeds")
+        zones = _frozen_array(self.zones, (n,), "LinearPath.zones")
+        if np.any(speeds <= 0):
+            raise IRError(f"LinearPath.speeds must be > 0 m/s (row {int(np.argmin(speeds))})")
+        if np.any(zones < 0):
+            raise IRError(f"LinearPath.zones must be >= 0 m (row {int(np.argmin(zones))})")
+        if self.angular is not None and not (np.isfinite(self.angular) and self.angular > 0):
+            raise IRError(f"LinearPath.angular must be > 0 rad/s, got {self.angular}")
+        object.__setattr__(self, "poses", poses)
+        object.__setattr__(self, "speeds", speeds)
+        object.__setattr__(self, "zones", zones)
+        object.__setattr__(self, "lines", _frozen_ints(self.lines, n, "LinearPath.lines"))
+        for name in ("widths", "labels"):
+            value = getattr(self, name)
+            if value is not None:
+                object.__setattr__(self, name, _frozen_ints(value, n, f"LinearPath.{name}"))
+
+    def __len__(self) -> int:
+        return int(self.poses.shape[0])
+
+    def __iter__(self) -> Iterator[LinearMove]:
+        return (self.move(k) for k in range(len(self)))
+
+    @property
+    def span(self) -> SourceSpan:
+        """The first row's span (where the node begins)."""
+        return self.row_span(0)
+
+    def row_span(self, k: int) -> SourceSpan:
+        """Where row ``k`` came from."""
+        line = int(self.lines[k])
+        if self.widths is None:
+            return SourceSpan(self.source, line)
+        return SourceSpan(self.source, line, 1, line, int(self.widths[k]) + 1)
+
+    def move(self, k: int) -> LinearMove:
+        """Row ``k`` as an ordinary :class:`LinearMove`."""
+        name = None if self.labels is None else str(int(self.labels[k]))
+        return LinearMove(
+            target=CartesianTarget.trusted(self.poses[k], name),
+            speed=_row_speed(float(self.speeds[k]), self.angular),
+            zone=Zone(float(self.zones[k])),
+            tool=self.tool,
+            frame=self.frame,
+            span=self.row_span(k),
+        )
+
+    def rows(self, start: int, stop: int) -> LinearPath:
+        """Rows ``start`` to ``stop`` (exclusive) as a node of their own."""
+        part = slice(start, stop)
+        return dataclasses.replace(
+            self,
+            poses=self.poses[part],
+            speeds=self.speeds[part],
+            zones=self.zones[part],
+            lines=self.lines[part],
+            widths=None if self.widths is None else self.widths[part],
+            labels=None if self.labels is None else self.labels[part],
+        )
+
+    def with_speeds(self, speeds: ArrayLike) -> LinearPath:
+        """A copy with other speeds (N,) m/s (or one for all rows), e.g. capped:
+        ``path.with_speeds(np.minimum(path.speeds, 0.1))``."""
+        return dataclasses.replace(self, speeds=np.broadcast_to(speeds, self.speeds.shape))
+
+    def with_zones(self, zones: ArrayLike) -> LinearPath:
+        """A copy with other zone radii (N,) m (or one for all rows)."""
+        return dataclasses.replace(self, zones=np.broadcast_to(zones, self.zones.shape))
+
+
+def _row_speed(linear: float, angular: float | None) -> Speed:
+    """A Speed of a validated row (no second check)."""
+    speed = object.__new__(Speed)
+    for name, value in (
+        ("linear", linear),
+        ("joint", 1.0),
+        ("angular", angular),
+        ("joint_acceleration", 1.0),
+    ):
+        object.__setattr__(speed, name, value)
+    return speed
+
+
+def _frozen_ints(value: Any, n: int, what: str) -> IntArray:
+    arr = np.array(value, dtype=np.int64)
+    if arr.shape != (n,):
+        raise IRError(f"{what}: expected shape ({n},), got {arr.shape}")
+    arr.setflags(write=False)
+    return arr
+
+
+def _check_rigid_rows(poses: FloatArray, what: str) -> None:
+    """:func:`_check_rigid` for poses (N, 4, 4), all at once; the error names the first bad
+    row."""
+    r = poses[:, :3, :3]
+    gram = np.einsum("nij,nkj->nik", r, r) - np.eye(3)
+    bad = np.max(np.abs(gram), axis=(1, 2)) > 1e-6
+    bad |= np.linalg.det(r) < 0
+    bad |= np.any(poses[:, 3, :] != (0.0, 0.0, 0.0, 1.0), axis=-1)
+    if np.any(bad):
+        k = int(np.argmax(bad))
+        _check_rigid(poses[k], f"{what} row {k}")
+        raise IRError(f"{what} row {k}: not a rigid transform")
+
+
+Node: TypeAlias = Instruction | LinearPath
+"""What a program holds: an instruction, or a dense run of linear moves."""
+
+
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Program:
-    """A named sequence of instructions read from ``source``."""
+    """A named sequence of instructions read from ``source``.
+
+    ``instructions`` holds the program's nodes: ordinary instructions and dense toolpaths
+    (:class:`LinearPath`). Iterating the program, ``len`` and the instruction indices that
+    diagnostics and reports give count every move of a toolpath as one instruction, as if the
+    program held ordinary moves only.
+    """
 
     name: str
-    instructions: tuple[Instruction, ...]
+    instructions: tuple[Node, ...]
     source: str = "<memory>"
 
     def __post_init__(self) -> None:
@@ -385,16 +546,25 @@ class Program:
             object.__setattr__(self, "instructions", tuple(self.instructions))
 
     def __iter__(self) -> Iterator[Instruction]:
-        return iter(self.instructions)
+        for node in self.instructions:
+            if isinstance(node, LinearPath):
+                yield from node
+            else:
+                yield node
 
     def __len__(self) -> int:
-        return len(self.instructions)
+        return sum(len(n) if isinstance(n, LinearPath) else 1 for n in self.instructions)
+
+    @property
+    def dense(self) -> bool:
+        """Whether the program holds a :class:`LinearPath`."""
+        return any(isinstance(n, LinearPath) for n in self.instructions)
 
     def motions(self) -> Iterator[Motion]:
-        """The motion instructions, in order."""
-        return (i for i in self.instructions if isinstance(i, MOTION_TYPES))
+        """The motion instructions, in order (every row of a toolpath)."""
+        return (i for i in self if isinstance(i, MOTION_TYPES))
 
-    def replace_instructions(self, instructions: Sequence[Instruction]) -> Program:
+    def replace_instructions(self, instructions: Sequence[Node]) -> Program:
         """A copy with other instructions (for IR -> IR transforms)."""
         return dataclasses.replace(self, instructions=tuple(instructions))
 
@@ -403,9 +573,11 @@ class Program:
 
     def map(self, edit: Callable[[Instruction], Edit]) -> Program:
         """A copy where every instruction is replaced by ``edit(instruction)``: an instruction,
-        a sequence of them (inserted in its place), or None (deleted)."""
-        out: list[Instruction] = []
-        for instruction in self.instructions:
+        a sequence of them (inserted in its place), or None (deleted). A toolpath's rows are
+        instructions like any other (the copy holds them as ordinary moves; for a dense edit of
+        a toolpath use :meth:`LinearPath.with_speeds` and friends)."""
+        out: list[Node] = []
+        for instruction in self:
             out.extend(_as_list(edit(instruction)))
         return self.replace_instructions(out)
 

@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from olp.compiled import CompiledProgram, Step
+from olp.compiled import CompiledProgram, Item, PathBlock, Step, StepBlocks, make_steps
 from olp.diagnostics import Diagnostic
 from olp.geometry import interpolate_poses, inv, pose_distance
 from olp.ir import (
@@ -39,7 +39,10 @@ from olp.ir import (
     JointMove,
     JointTarget,
     LinearMove,
+    LinearPath,
+    Node,
     Program,
+    SourceSpan,
     Tool,
 )
 from olp.kinematics.base import turn_variants
@@ -87,37 +90,55 @@ class ResolveOptions:
 def resolve(
     program: Program, station: Station, options: ResolveOptions | None = None
 ) -> CompiledProgram:
-    """Resolve every motion of ``program`` on ``station``; never raises on a bad program."""
+    """Resolve every motion of ``program`` on ``station``; never raises on a bad program.
+
+    A dense toolpath (:class:`~olp.ir.LinearPath`) is resolved in vectorised batches into
+    :class:`~olp.compiled.PathBlock`\\ s; a row that fails is analysed alone and becomes an
+    ordinary step (the program's nodes are then split around it, with the same instructions).
+    """
     opts = options or ResolveOptions()
     robot = station.robot
     state = _State(q=robot.home.copy(), robot=robot, opts=opts)
-    steps: list[Step] = []
+    items: list[Item] = []
     diags: list[Diagnostic] = []
-    instructions = program.instructions
-    index = 0
-    while index < len(instructions):
-        ins = instructions[index]
-        run = _linear_run(instructions, index, station)
-        if run:
-            found_steps, found = _resolve_linear_run(index, run, station, state)
-            steps.extend(found_steps)
+    nodes = program.instructions
+    index = flat = 0
+    while index < len(nodes):
+        node = nodes[index]
+        if isinstance(node, LinearPath):
+            found_items, found = _resolve_path(flat, node, station, state)
+            items.extend(found_items)
             diags.extend(found)
-            index += len(run)
+            index, flat = index + 1, flat + len(node)
             continue
-        if isinstance(ins, MOTION_TYPES):
-            step, found = _resolve_motion(index, ins, station, state)
-            steps.append(step)
+        run = _linear_run(nodes, index, flat, station)
+        if run:
+            found_items, found = _resolve_linear_run(run, station, state)
+            items.extend(found_items)
+            diags.extend(found)
+            index, flat = index + len(run), flat + len(run)
+            continue
+        if isinstance(node, MOTION_TYPES):
+            step, found = _resolve_motion(flat, node, station, state)
+            items.append(step)
             diags.extend(found)
         else:
-            steps.append(Step(index=index, instruction=ins))
-        index += 1
+            items.append(Step(index=flat, instruction=node))
+        index, flat = index + 1, flat + 1
+    steps = make_steps(items)
+    if isinstance(steps, StepBlocks):
+        program = program.replace_instructions([_node_of(item) for item in steps.blocks])
     return CompiledProgram(
         program=program,
         station=station,
         start_joints=robot.home.copy(),
-        steps=tuple(steps),
+        steps=steps,
         diagnostics=tuple(diags),
     )
+
+
+def _node_of(item: Item) -> Node:
+    return item.node if isinstance(item, PathBlock) else item.instruction
 
 
 @dataclass(slots=True)
@@ -143,19 +164,70 @@ _BATCH_SAMPLES = MAX_SAMPLES
 """Most TCP samples per batch (bounds memory: ~1 kB of temporaries per sample)."""
 
 
-def _linear_run(
-    instructions: tuple[Instruction, ...], start: int, station: Station
-) -> list[tuple[LinearMove, Tool, Frame]]:
-    """The consecutive linear moves from ``start`` to Cartesian targets with one resolvable tool
-    and resolvable frames, with their resolved tool and frames (empty if none start here).
+@dataclass(frozen=True, slots=True, eq=False)
+class _Run:
+    """Consecutive linear moves to Cartesian targets with one tool, as arrays.
 
-    Walks the instructions by index: a slice ``instructions[start:]`` would copy the rest of
-    the program for every instruction that starts no run, which made resolve quadratic in
-    non-motion instructions (200,000 comments: 70 s)."""
-    run: list[tuple[LinearMove, Tool, Frame]] = []
+    ``first``: the instruction index of move 0; ``poses`` (M, 4, 4): the targets in their
+    frames; ``frame_poses`` (M, 4, 4) or one (4, 4): the frames in the world; ``speeds`` (M,)
+    m/s; ``tool``: resolved. Move ``k`` as an instruction is ``moves[k]`` (ordinary moves) or
+    row ``offset + k`` of ``node`` (a dense toolpath, whose rows share one ``frame``).
+    """
+
+    first: int
+    poses: FloatArray
+    frame_poses: FloatArray
+    speeds: FloatArray
+    tool: Tool
+    frames: tuple[Frame, ...] = ()
+    moves: tuple[LinearMove, ...] = ()
+    node: LinearPath | None = None
+    offset: int = 0
+
+    def __len__(self) -> int:
+        return int(self.speeds.shape[0])
+
+    def targets(self) -> FloatArray:
+        """The TCP targets (M, 4, 4) in the world."""
+        return np.asarray(self.frame_poses @ self.poses, dtype=np.float64)
+
+    def move(self, k: int) -> LinearMove:
+        return self.moves[k] if self.node is None else self.node.move(self.offset + k)
+
+    def frame(self, k: int) -> Frame:
+        return self.frames[k] if self.node is None else self.frames[0]
+
+    def span(self, k: int) -> SourceSpan:
+        return self.moves[k].span if self.node is None else self.node.row_span(self.offset + k)
+
+    def rows(self, start: int, stop: int) -> _Run:
+        """Moves ``start`` to ``stop`` (exclusive)."""
+        part = slice(start, stop)
+        dense = self.node is not None
+        return dataclasses.replace(
+            self,
+            first=self.first + start,
+            poses=self.poses[part],
+            frame_poses=self.frame_poses if dense else self.frame_poses[part],
+            speeds=self.speeds[part],
+            frames=self.frames if dense else self.frames[part],
+            moves=self.moves[part],
+            offset=self.offset + start,
+        )
+
+
+def _linear_run(nodes: tuple[Node, ...], start: int, first: int, station: Station) -> _Run | None:
+    """The consecutive linear moves from node ``start`` (instruction ``first``) to Cartesian
+    targets with one resolvable tool and resolvable frames (None if none start here).
+
+    Walks the nodes by index: a slice ``nodes[start:]`` would copy the rest of the program for
+    every instruction that starts no run, which made resolve quadratic in non-motion
+    instructions (200,000 comments: 70 s)."""
+    moves: list[LinearMove] = []
+    frames: list[Frame] = []
     first_tool: Tool | None = None
-    for index in range(start, len(instructions)):
-        ins = instructions[index]
+    for index in range(start, len(nodes)):
+        ins = nodes[index]
         if not (isinstance(ins, LinearMove) and isinstance(ins.target, CartesianTarget)):
             break
         tool = ins.tool if ins.tool.pose is not None else station.tool(ins.tool)
@@ -163,64 +235,109 @@ def _linear_run(
         if tool is None or frame is None or (first_tool is not None and tool != first_tool):
             break
         first_tool = tool
-        run.append((ins, tool, frame))
-    return run
+        moves.append(ins)
+        frames.append(frame)
+    if first_tool is None:
+        return None
+    return _Run(
+        first=first,
+        poses=np.stack([m.target.pose for m in moves]),  # type: ignore[union-attr]
+        frame_poses=np.stack([_world(f) for f in frames]),
+        speeds=np.array([m.speed.linear for m in moves], dtype=np.float64),
+        tool=first_tool,
+        frames=tuple(frames),
+        moves=tuple(moves),
+    )
+
+
+def _resolve_path(
+    first: int, node: LinearPath, station: Station, state: _State
+) -> tuple[list[Item], list[Diagnostic]]:
+    """Resolve a dense toolpath: its rows as one run (tool and frame looked up once)."""
+    tool = node.tool if node.tool.pose is not None else station.tool(node.tool)
+    frame = node.frame if node.frame.pose is not None else station.frame(node.frame)
+    if tool is None or frame is None:
+        missing = [
+            (f"tool {node.tool.name!r}" if tool is None else ""),
+            (f"frame {node.frame.name!r}" if frame is None else ""),
+        ]
+        kind = "unknown_tool" if tool is None else "unknown_frame"
+        msg = f"{' and '.join(m for m in missing if m)} not defined in the station"
+        block = PathBlock(first, node, tool, frame)
+        return [block], [Diagnostic("error", kind, msg, node.span, first)]
+    run = _Run(
+        first=first,
+        poses=node.poses,
+        frame_poses=_world(frame),
+        speeds=node.speeds,
+        tool=tool,
+        frames=(frame,),
+        node=node,
+    )
+    return _resolve_linear_run(run, station, state)
 
 
 def _resolve_linear_run(
-    first: int, run: list[tuple[LinearMove, Tool, Frame]], station: Station, state: _State
-) -> tuple[list[Step], list[Diagnostic]]:
+    run: _Run, station: Station, state: _State
+) -> tuple[list[Item], list[Diagnostic]]:
     """Resolve consecutive linear moves in vectorised batches.
 
     The whole chain is sampled and solved at once in the branch it starts in. At the first
     sample that fails (no solution, a joint limit, a joint jump), or at a move too long to
     sample in a batch, the moves before it are accepted and the failing move is analysed alone
     by the per-move code, which words the diagnostic exactly as for a single move (the same
-    sampling rules apply); the batch then goes on after it.
+    sampling rules apply); the batch then goes on after it. The moves of a dense toolpath are
+    accepted as blocks (arrays), ordinary moves as steps.
     """
-    steps: list[Step] = []
+    items: list[Item] = []
     diags: list[Diagnostic] = []
     k, size = 0, _RUN_CHUNK
     while k < len(run):
-        chunk = run[k : k + size]
+        chunk = run.rows(k, min(k + size, len(run)))
         batch = _batch_path(chunk, state)
         good, samples = batch.good, batch.samples
         if good:
             assert samples is not None
-            moves = chunk[:good]
-            diags.extend(_speed_warnings(first + k, moves, batch.path, samples, state.robot))
+            moves = chunk.rows(0, good)
+            diags.extend(_speed_warnings(moves, batch.path, samples, state.robot))
             ends = samples.ends[:good] + 1
             fractions = np.concatenate([[0.0], samples.fractions[: int(ends[-1])]])
-            diags.extend(_singular_warnings(first + k, moves, batch.path, ends, fractions, state))
-            steps.extend(_batch_steps(first + k, moves, batch.path, ends))
+            diags.extend(_singular_warnings(moves, batch.path, ends, fractions, state))
+            items.extend(_batch_items(moves, batch.path, ends))
             state.q = batch.path[int(ends[-1])].copy()
         if batch.bad is not None:
-            step, found = _resolve_motion(first + k + good, chunk[good][0], station, state)
-            steps.append(step)
+            step, found = _resolve_motion(chunk.first + good, chunk.move(good), station, state)
+            items.append(step)
             diags.extend(found)
             size = _RETRY_CHUNK
         elif good == len(chunk):
             size = min(2 * size, _RUN_CHUNK)
         k += good + (0 if batch.bad is None else 1)
-    return steps, diags
+    return items, diags
 
 
-def _batch_steps(
-    first: int, moves: list[tuple[LinearMove, Tool, Frame]], path: FloatArray, ends: IntArray
-) -> list[Step]:
-    """One step per move of a batch: its rows of the batch's joint path (S + 1, 6), from the
-    previous move's end row (``ends`` (M,): each move's last row)."""
-    steps = []
-    for m, (ins, tool, frame) in enumerate(moves):
+def _batch_items(run: _Run, path: FloatArray, ends: IntArray) -> list[Item]:
+    """The moves of a batch: their rows of the batch's joint path (S + 1, 6), each from the
+    previous move's end row (``ends`` (M,): each move's last row) - one block for a dense
+    toolpath, one step per move otherwise."""
+    path = path[: int(ends[-1]) + 1]
+    if run.node is not None:
+        rows = run.node.rows(run.offset, run.offset + len(run))
+        block = PathBlock(
+            run.first, rows, run.tool, run.frame(0), path[ends], path, np.asarray(ends)
+        )
+        return [block]
+    steps: list[Item] = []
+    for m in range(len(run)):
         segment = path[(0 if m == 0 else int(ends[m - 1])) : int(ends[m]) + 1]
         steps.append(
             Step(
-                index=first + m,
-                instruction=ins,
+                index=run.first + m,
+                instruction=run.move(m),
                 joints=segment[-1],
                 path=segment,
-                tool=tool,
-                frame=frame,
+                tool=run.tool,
+                frame=run.frame(m),
             )
         )
     return steps
@@ -239,14 +356,14 @@ class _Batch:
     bad: int | None
 
 
-def _batch_path(chunk: list[tuple[LinearMove, Tool, Frame]], state: _State) -> _Batch:
+def _batch_path(chunk: _Run, state: _State) -> _Batch:
     """Sample and solve a chain of linear moves from ``state.q``, as many as fit in
     ``_BATCH_SAMPLES`` samples: a move that alone needs more than ``MAX_SAMPLES`` stops the
     batch (the per-move code reports it; an absurd target never allocates its samples)."""
     robot, opts = state.robot, state.opts
-    tool_pose = chunk[0][1].pose
+    tool_pose = chunk.tool.pose
     assert tool_pose is not None
-    targets = np.stack([_world(frame) @ ins.target.pose for ins, _, frame in chunk])  # type: ignore[union-attr]
+    targets = chunk.targets()
     start = robot.flange_poses(state.q) @ tool_pose
     counts = segment_counts(start, targets, opts.step_m, opts.step_rad)
     fit, too_long = _fitting(counts)
@@ -276,11 +393,7 @@ def _fitting(counts: FloatArray) -> tuple[int, bool]:
 
 
 def _speed_warnings(
-    first: int,
-    moves: list[tuple[LinearMove, Tool, Frame]],
-    path: FloatArray,
-    samples: SegmentSamples,
-    robot: Robot,
+    moves: _Run, path: FloatArray, samples: SegmentSamples, robot: Robot
 ) -> list[Diagnostic]:
     """Warn where the programmed TCP speed needs a joint faster than its limit.
 
@@ -294,7 +407,7 @@ def _speed_warnings(
     rows = int(samples.ends[m - 1]) + 1
     segment = samples.segment[:rows]
     counts = np.diff(np.concatenate([[-1], samples.ends[:m]]))
-    speeds = np.array([ins.speed.linear for ins, _, _ in moves])
+    speeds = moves.speeds
     spacing = samples.lengths[:m] / counts
     dq = np.abs(np.diff(path[: rows + 1], axis=0))
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
@@ -308,7 +421,7 @@ def _speed_warnings(
         rows_in = (segment >= lo) & (segment < hi)
         row = int(np.argmax(np.where(rows_in[:, None], ratio, 0.0)) // ratio.shape[1])
         joint = int(np.argmax(ratio[row]))
-        ins = moves[lo][0]
+        first = moves.first
         where = f"move {first + lo}" if hi - lo == 1 else f"moves {first + lo}-{first + hi - 1}"
         need, limit = wording.above(
             float(np.degrees(needed[row, joint])), float(np.degrees(robot.limits.velocity[joint]))
@@ -317,9 +430,9 @@ def _speed_warnings(
             Diagnostic(
                 "warning",
                 "speed_limited",
-                f"{where}: {wording.quantity(ins.speed.linear * 1000, 0)} mm/s needs axis "
+                f"{where}: {wording.quantity(float(speeds[lo]) * 1000, 0)} mm/s needs axis "
                 f"{joint + 1} at {need}°/s (limit {limit}°/s); the TCP will be slower there",
-                ins.span,
+                moves.span(lo),
                 first + lo,
                 joints=path[row + 1],
                 hint="lower the speed, or keep the path away from singular poses",
@@ -360,8 +473,7 @@ _SINGULARITIES = (
 
 
 def _singular_warnings(
-    first: int,
-    moves: list[tuple[LinearMove, Tool, Frame]],
+    moves: _Run,
     path: FloatArray,
     ends: IntArray,
     fractions: FloatArray,
@@ -399,6 +511,7 @@ def _singular_warnings(
         "elbow": np.sin(state.opts.singular_angle_rad),
     }
     starts = np.concatenate([[0], ends[:-1]])
+    first = moves.first
     out: list[Diagnostic] = []
     for name, detail, undefined, hint in _SINGULARITIES:
         distance = _closest(getattr(found, name))
@@ -428,7 +541,7 @@ def _singular_warnings(
                     f"linear move {first + lo} {verb} the {name} singularity ({text}): "
                     f"{undefined}, so the controller may stop the move there or take other "
                     f"joint values than olp planned{also}",
-                    moves[lo][0].span,
+                    moves.span(lo),
                     first + lo,
                     joints=path[row],
                     hint=hint,
@@ -727,7 +840,16 @@ def _linear_path(
         hint = "use a joint move, or change the tool orientation to avoid the singular pose"
         return None, [_error("singularity", msg, index, ins, joints=path[row], hint=hint)]
     ends = np.array([count], dtype=np.int64)
-    return path, _singular_warnings(index, [(ins, tool, frame)], path, ends, fractions, state)
+    one = _Run(
+        first=index,
+        poses=np.asarray(end)[None],
+        frame_poses=np.eye(4)[None],
+        speeds=np.array([ins.speed.linear]),
+        tool=tool,
+        frames=(frame,),
+        moves=(ins,),
+    )
+    return path, _singular_warnings(one, path, ends, fractions, state)
 
 
 def _joint_target_error(

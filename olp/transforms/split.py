@@ -104,7 +104,7 @@ def split_program(
     """IR -> IR: ``(main, parts)``. With no limit exceeded, ``main`` is the program itself and
     ``parts`` is empty; otherwise ``main`` holds one :class:`~olp.ir.Call` per part, in order.
     ``limits.max_lines`` is not applied here (it needs the rendered text)."""
-    instructions = program.instructions
+    instructions = tuple(program)  # a toolpath's rows, one instruction each
     motions = [is_motion(i) for i in instructions]
     bounds = split_bounds(motions, [True] * len(instructions), limits)
     if len(bounds) == 1:

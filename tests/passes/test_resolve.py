@@ -136,7 +136,7 @@ def _helix(station: Station, count: int, z_drop: float = 0.0) -> list[ir.Instruc
 def _per_move(monkeypatch: pytest.MonkeyPatch, program: ir.Program, station: Station) -> object:
     import olp.passes.resolve as module
 
-    monkeypatch.setattr(module, "_linear_run", lambda *_: [])
+    monkeypatch.setattr(module, "_linear_run", lambda *_: None)
     return resolve(program, station)
 
 
