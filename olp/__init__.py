@@ -11,7 +11,16 @@ from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["BuildResult", "build", "compile", "ir", "load_station", "parse", "posts"]
+__all__ = [
+    "BuildOptions",
+    "BuildResult",
+    "build",
+    "compile",
+    "ir",
+    "load_station",
+    "parse",
+    "posts",
+]
 
 
 def __getattr__(name: str) -> Any:
@@ -19,10 +28,14 @@ def __getattr__(name: str) -> Any:
         from olp import api
 
         return getattr(api, name)
-    if name == "posts":
-        from olp.posts import available_posts
+    if name == "BuildOptions":
+        from olp.passes.pipeline import BuildOptions
 
-        return available_posts
+        return BuildOptions
+    if name == "posts":
+        import olp.posts as posts
+
+        return posts
     if name == "ir":
         import olp.ir as ir
 

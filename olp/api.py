@@ -1,7 +1,7 @@
 """The library API: ``olp.build(station, program, post="kuka")`` does what ``olp build`` does.
 
 Stages, each a plain function: :func:`load_station`, :func:`parse` (file -> ir.Program),
-:func:`compile` (resolve + timing -> CompiledProgram), :func:`render` / :func:`build`.
+:func:`compile` (the pass pipeline -> CompiledProgram), :func:`build` (compile, then a post).
 """
 
 from __future__ import annotations
@@ -13,16 +13,18 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from olp.compiled import CompiledProgram
 from olp.diagnostics import Diagnostic, has_errors
 from olp.errors import UsageError
 from olp.frontends import ParsedProgram, check_options, frontend_for
 from olp.ir import Program
 from olp.passes.collide import CollisionOptions
-from olp.passes.resolve import CompiledProgram, ResolveOptions, resolve
+from olp.passes.resolve import ResolveOptions
 from olp.station.loader import load_station as _load_station
 from olp.station.model import Station
 
 if TYPE_CHECKING:
+    from olp.passes.pipeline import BuildOptions, Pass
     from olp.posts.base import Post
 
 
@@ -51,31 +53,38 @@ def parse(
     return frontend.load(path, check_options(frontend, options, path), station)
 
 
-_DEFAULT_COLLISIONS = CollisionOptions()
-"""Collision checks run by default (pass ``collisions=None`` to skip them)."""
+_DEFAULT = object()
+"""Marks a keyword the caller did not give."""
 
 
 def compile(
     program: Program,
     station: Station,
-    options: ResolveOptions | None = None,
+    options: BuildOptions | ResolveOptions | None = None,
     *,
-    collisions: CollisionOptions | None = _DEFAULT_COLLISIONS,
+    passes: tuple[Pass, ...] | None = None,
+    collisions: CollisionOptions | object | None = _DEFAULT,
     other_times: Mapping[str, float] | None = None,
 ) -> CompiledProgram:
-    """Resolve, check collisions and time ``program`` on ``station``. Never raises on a bad
-    program. ``collisions``: options of the collision check (default options if not given),
-    or None to skip it; ``other_times``: seconds per non-motion instruction kind (see
-    :data:`olp.passes.timing.DEFAULT_TIMES`)."""
-    from olp.passes.timing import time_program
+    """``program`` on ``station`` through the pass pipeline (resolve, collisions, timing: see
+    :mod:`olp.passes.pipeline`); never raises on a bad program.
 
-    compiled = resolve(program, station, options)
-    if collisions is not None:
-        from olp.passes.collide import check_collisions
+    ``options``: a :class:`~olp.passes.pipeline.BuildOptions` (a bare
+    :class:`~olp.passes.resolve.ResolveOptions` is taken as its ``resolve`` part);
+    ``passes``: another pipeline, e.g. with a pass of your own. ``collisions`` (None: no
+    collision check) and ``other_times`` override the options' fields where given.
+    """
+    from olp.passes.pipeline import PIPELINE, BuildOptions, run_passes
 
-        found = tuple(check_collisions(compiled, collisions))
-        compiled = dataclasses.replace(compiled, diagnostics=compiled.diagnostics + found)
-    return time_program(compiled, other_times) if compiled.ok else compiled
+    if isinstance(options, ResolveOptions):
+        options = BuildOptions(resolve=options)
+    opts = options or BuildOptions()
+    if collisions is not _DEFAULT:
+        assert collisions is None or isinstance(collisions, CollisionOptions)
+        opts = dataclasses.replace(opts, collisions=collisions)
+    if other_times is not None:
+        opts = dataclasses.replace(opts, other_times=other_times)
+    return run_passes(program, station, opts, PIPELINE if passes is None else passes)
 
 
 @dataclass(frozen=True, slots=True)
@@ -100,15 +109,17 @@ def build(
     out_dir: str | Path | None = None,
     name: str | None = None,
     *,
-    options: ResolveOptions | None = None,
+    options: BuildOptions | ResolveOptions | None = None,
     program_options: object | None = None,
-    collisions: CollisionOptions | None = _DEFAULT_COLLISIONS,
+    collisions: CollisionOptions | object | None = _DEFAULT,
+    passes: tuple[Pass, ...] | None = None,
 ) -> BuildResult:
     """Compile ``program`` on ``station`` and render it through ``post``.
 
-    ``options`` set the checks (e.g. ``ResolveOptions(skip_unreachable=True)``);
-    ``program_options`` are the frontend's options for reading ``program`` when it is a file
-    (see :func:`parse`; e.g. ``CsvOptions(frame="table")``, ``DslOptions(params={"SIDES": 6})``).
+    ``options``, ``passes`` and ``collisions`` as for :func:`compile` (e.g.
+    ``BuildOptions(resolve=ResolveOptions(skip_unreachable=True))``); ``program_options`` are
+    the frontend's options for reading ``program`` when it is a file (see :func:`parse`; e.g.
+    ``CsvOptions(frame="table")``, ``DslOptions(params={"SIDES": 6})``).
     Files are written to ``out_dir`` (if given) only when no error diagnostic remains.
     """
     from olp.posts import find_post
@@ -128,7 +139,7 @@ def build(
     elif program_options is not None:
         raise UsageError("program_options are for reading a program file, not an ir.Program")
     writer = post if isinstance(post, Post) else find_post(post)
-    compiled = compile(program, station, options, collisions=collisions)
+    compiled = compile(program, station, options, passes=passes, collisions=collisions)
     diagnostics = notes + compiled.diagnostics
     if not compiled.ok:
         return BuildResult(compiled, writer.name, diagnostics)

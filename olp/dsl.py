@@ -60,8 +60,8 @@ from olp import ir
 from olp.geometry import inv
 
 if TYPE_CHECKING:
+    from olp.compiled import CompiledProgram, Step
     from olp.frontends.dsl import Session
-    from olp.passes.resolve import CompiledProgram, Step
     from olp.station.model import Station
 
 FloatArray = NDArray[np.float64]

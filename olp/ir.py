@@ -1,7 +1,7 @@
 """The intermediate representation: what a robot program *means*, in SI units.
 
 Every frontend lowers to these frozen dataclasses and every post renders from them (through
-:class:`olp.passes.resolve.CompiledProgram`). The IR never says how one vendor spells a thing.
+:class:`olp.compiled.CompiledProgram`). The IR never says how one vendor spells a thing.
 
 Conventions
 -----------

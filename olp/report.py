@@ -28,7 +28,7 @@ from olp.passes.wording import quantity
 if TYPE_CHECKING:
     from numpy.typing import NDArray
 
-    from olp.passes.resolve import CompiledProgram
+    from olp.compiled import CompiledProgram
 
 SCHEMA_VERSION = 1
 

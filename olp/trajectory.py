@@ -24,8 +24,6 @@ TCP in the station's world frame) and ``instruction`` (0-based index of the inst
 from __future__ import annotations
 
 import io
-import os
-import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -38,7 +36,7 @@ from olp.errors import UsageError
 from olp.ir import is_motion
 
 if TYPE_CHECKING:
-    from olp.passes.resolve import CompiledProgram
+    from olp.compiled import CompiledProgram
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -386,14 +384,8 @@ def instruction_starts(compiled: CompiledProgram) -> list[float]:
 
 
 def write_atomic(path: Path, data: bytes) -> Path:
-    """Write ``data`` to ``path`` through a temporary file in the same folder and a rename."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as handle:
-            handle.write(data)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
+    """Write ``data`` to ``path`` atomically, with the umask's mode
+    (:func:`olp.output.write_file`)."""
+    from olp.output import write_file
+
+    return write_file(path, data)

@@ -191,7 +191,11 @@ CASES: dict[str, Case] = {
     ),
     "dsl: os._exit(0)": dsl("import os\nos._exit(0)\n", 2, r"prog\.py:4:\d+: .*os\._exit"),
     "dsl: timeout": dsl(
-        "while True:\n    pass\n", 2, r"prog\.py:3:1: .*did not finish within 1 s", "--timeout", "1"
+        "while True:\n    pass\n",
+        2,
+        r"prog\.py:[34]:\d+: .*did not finish within 1 s",
+        "--timeout",
+        "1",
     ),
     "dsl: syntax error": dsl("robot.MoveJ(\n", 2, r"prog\.py:\d+:\d+: "),
     "dsl: call with a statement": dsl(

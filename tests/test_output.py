@@ -193,3 +193,10 @@ def test_output_names_must_be_plain_file_names(tmp_path: Path) -> None:
         with pytest.raises(UsageError):
             write_folder({name: b"x"}, tmp_path / "out")
     assert not (tmp_path / "escape.src").exists()
+
+
+def test_trajectory_files_follow_the_umask(tmp_path: Path, umask_022: None) -> None:
+    from olp.trajectory import write_atomic
+
+    written = write_atomic(tmp_path / "joints.csv", b"t\n")
+    assert written.stat().st_mode & 0o777 == 0o644

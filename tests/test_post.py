@@ -18,10 +18,10 @@ import pytest
 import olp
 from olp import ir, output
 from olp.cli import main
+from olp.compiled import CompiledProgram
 from olp.diagnostics import Diagnostic
 from olp.errors import PostError, UsageError
 from olp.output import MANIFEST
-from olp.passes.resolve import CompiledProgram
 from olp.posts import available_posts, find_post, load_post
 from olp.posts.base import Post
 from olp.posts.manifest import load_manifest

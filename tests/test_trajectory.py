@@ -14,8 +14,9 @@ import toppra
 from ruckig import InputParameter, Ruckig, Synchronization, Trajectory
 
 from olp import ir
+from olp.compiled import CompiledProgram
 from olp.errors import UsageError
-from olp.passes.resolve import CompiledProgram, resolve
+from olp.passes.resolve import resolve
 from olp.passes.timing import time_program
 from olp.station.loader import load_station
 from olp.station.model import Station

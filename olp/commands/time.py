@@ -30,7 +30,7 @@ from olp.commands.options import (
 from olp.errors import UsageError
 
 if TYPE_CHECKING:
-    from olp.passes.resolve import CompiledProgram
+    from olp.compiled import CompiledProgram
 
 NAME = "time"
 HELP = "estimate a program's cycle time: per instruction, speed sweeps, trajectory CSV and plot"

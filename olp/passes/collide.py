@@ -63,7 +63,8 @@ from olp.passes.wording import percent
 if TYPE_CHECKING:
     from olp.collision.advance import Hit, Unresolved
     from olp.collision.scene import ConstantPair, Placed, Scene
-    from olp.passes.resolve import CompiledProgram, Step
+    from olp.compiled import CompiledProgram, Step
+    from olp.passes.pipeline import BuildOptions
     from olp.station.model import Station
 
 FloatArray = NDArray[np.float64]
@@ -532,3 +533,11 @@ def _diagnostic(items: Sequence[_Found], clearance: float) -> Diagnostic:
         joints=hit.joints,
         hint=_HINTS[first.kind],
     )
+
+
+def collision_pass(compiled: CompiledProgram, options: BuildOptions) -> CompiledProgram:
+    """The collision pass: :func:`check_collisions` with ``options.collisions`` (None: no
+    check), its findings appended to the diagnostics."""
+    if options.collisions is None:
+        return compiled
+    return compiled.with_diagnostics(check_collisions(compiled, options.collisions))

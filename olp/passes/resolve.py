@@ -13,20 +13,21 @@
   starts, ends or passes at a singular pose (wrist, shoulder, elbow) without a jump gets a
   warning (:func:`_singular_warnings`).
 
-The result is a :class:`CompiledProgram`: the program, one :class:`Step` per instruction (end
-joints, resolved tool and frame, sampled joint path of a motion) and the diagnostics.
+The result is a :class:`olp.compiled.CompiledProgram`: the program, one step per instruction
+(end joints, resolved tool and frame, sampled joint path of a motion) and the diagnostics.
 """
 
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
-from olp.diagnostics import Diagnostic, has_errors
+from olp.compiled import CompiledProgram, Step
+from olp.diagnostics import Diagnostic
 from olp.geometry import interpolate_poses, inv, pose_distance
 from olp.ir import (
     MOTION_TYPES,
@@ -40,7 +41,6 @@ from olp.ir import (
     LinearMove,
     Program,
     Tool,
-    is_motion,
 )
 from olp.kinematics.base import turn_variants
 from olp.kinematics.singularity import ON_SINGULARITY, meeting_branches, singularity_distances
@@ -49,7 +49,7 @@ from olp.passes.sampling import MAX_SAMPLES, SegmentSamples, sample_segments, se
 from olp.station.model import Robot, Station
 
 if TYPE_CHECKING:
-    from olp.trajectory import Segment
+    from olp.passes.pipeline import BuildOptions
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -82,52 +82,6 @@ class ResolveOptions:
     # of a shoulder singularity; nearer than that, the pose does not decide the joints.
     singular_angle_rad: float = 1e-3
     singular_distance_m: float = 1e-4
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class Step:
-    """One instruction as compiled.
-
-    ``joints``: joints at the end of a motion, (6,) rad; ``path``: the sampled joint path of a
-    motion including its start, (S, 6) rad; ``duration`` (s), ``path_length`` (m of TCP travel)
-    and ``trajectory`` (the timed motion, to sample joints over time) are filled by the timing
-    pass.
-    """
-
-    index: int
-    instruction: Instruction
-    joints: FloatArray | None = None
-    path: FloatArray | None = None
-    tool: Tool | None = None
-    frame: Frame | None = None
-    duration: float = 0.0
-    path_length: float = 0.0
-    trajectory: Segment | None = None
-    skipped: bool = False
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class CompiledProgram:
-    """A program resolved on a station: steps (one per instruction) and diagnostics."""
-
-    program: Program
-    station: Station
-    start_joints: FloatArray
-    steps: tuple[Step, ...]
-    diagnostics: tuple[Diagnostic, ...] = field(default=())
-
-    @property
-    def ok(self) -> bool:
-        """No error diagnostics: code may be written."""
-        return not has_errors(self.diagnostics)
-
-    @property
-    def cycle_time(self) -> float:
-        """Total estimated time, seconds."""
-        return float(sum(s.duration for s in self.steps))
-
-    def motion_steps(self) -> list[Step]:
-        return [s for s in self.steps if is_motion(s.instruction)]
 
 
 def resolve(
@@ -924,6 +878,8 @@ def _range(robot: Robot, joint: int) -> str:
     return f"{wording.exact(float(lower))}° .. {wording.exact(float(upper))}°"
 
 
-def replace_step(step: Step, **changes: object) -> Step:
-    """A copy of ``step`` with fields changed (used by later passes)."""
-    return dataclasses.replace(step, **changes)  # type: ignore[arg-type]
+def resolve_pass(compiled: CompiledProgram, options: BuildOptions) -> CompiledProgram:
+    """The resolve pass: every motion of ``compiled.program`` resolved on its station
+    (:func:`resolve`, with ``options.resolve``); diagnostics of earlier passes are kept."""
+    resolved = resolve(compiled.program, compiled.station, options.resolve)
+    return dataclasses.replace(resolved, diagnostics=compiled.diagnostics + resolved.diagnostics)

@@ -54,7 +54,7 @@ from olp.posts.text import IDENTIFIER, NUMBER, ArgumentRule, NameRule, one_of
 from olp.vendors.abb import confdata, normalised_rounded, pose_to_robtarget
 
 if TYPE_CHECKING:
-    from olp.passes.resolve import CompiledProgram, Step
+    from olp.compiled import CompiledProgram, Step
     from olp.posts.view import PostFrame, PostStep, PostTool
 
 QUATERNION_DECIMALS = 9

@@ -59,7 +59,7 @@ from olp.posts.text import (
 )
 
 if TYPE_CHECKING:
-    from olp.passes.resolve import CompiledProgram, Step
+    from olp.compiled import CompiledProgram, Step
     from olp.posts.manifest import PostManifest
     from olp.posts.view import PostStep
 

@@ -92,7 +92,7 @@ from olp.vendors.fanuc import (
 )
 
 if TYPE_CHECKING:
-    from olp.passes.resolve import CompiledProgram
+    from olp.compiled import CompiledProgram
     from olp.posts.view import PostStep
 
 FloatArray = NDArray[np.float64]

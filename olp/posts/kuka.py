@@ -53,7 +53,7 @@ from olp.posts.text import IDENTIFIER, NUMBER, ArgumentRule, NameRule, double_qu
 from olp.vendors.kuka import pose_to_frame, status_turn, turn_ambiguous
 
 if TYPE_CHECKING:
-    from olp.passes.resolve import CompiledProgram, Step
+    from olp.compiled import CompiledProgram, Step
     from olp.posts.view import PostStep
 
 _KEYWORDS = """

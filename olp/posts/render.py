@@ -55,7 +55,7 @@ from olp.posts.view import Allocation, Modal, Names, PostFrame, PostStep, PostTo
 from olp.transforms.split import SplitLimits, part_names, split_steps
 
 if TYPE_CHECKING:
-    from olp.passes.resolve import CompiledProgram, Step
+    from olp.compiled import CompiledProgram, Step
     from olp.posts.base import Post
 
 

@@ -58,7 +58,7 @@ from olp.posts.text import NUMBER, ArgumentRule, CommentRule, NameRule
 from olp.vendors.ur import pose_to_ur
 
 if TYPE_CHECKING:
-    from olp.passes.resolve import CompiledProgram
+    from olp.compiled import CompiledProgram
     from olp.posts.view import PostStep
 
 _KEYWORDS = """

@@ -20,7 +20,7 @@ from olp.geometry import inv
 from olp.ir import FLANGE, MOTION_TYPES, CartesianTarget, CircularMove, Frame, JointMove, Tool
 
 if TYPE_CHECKING:
-    from olp.passes.resolve import CompiledProgram, Step
+    from olp.compiled import CompiledProgram, Step
     from olp.posts.manifest import PostManifest
     from olp.posts.text import NameRule
 

@@ -39,9 +39,9 @@ from typing import Any, Protocol
 import numpy as np
 from numpy.typing import NDArray
 
+from olp.compiled import CompiledProgram
 from olp.diagnostics import Diagnostic
 from olp.ir import Call, Instruction, Wait, WaitInput, is_motion
-from olp.passes.resolve import CompiledProgram
 from olp.station.model import Robot
 
 FloatArray = NDArray[np.float64]
@@ -51,7 +51,7 @@ STOP_TYPES = (Wait, WaitInput, Call)
 
 
 class StepLike(Protocol):
-    """What the rule reads of a step: :class:`olp.passes.resolve.Step` and
+    """What the rule reads of a step: :class:`olp.compiled.Step` and
     :class:`olp.posts.view.PostStep` both fit."""
 
     @property

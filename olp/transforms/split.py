@@ -7,7 +7,7 @@ program's order: a part takes instructions until the next *motion* would exceed
 ``max_motions`` or the next instruction would exceed ``max_instructions``. Non-motion
 instructions (an output set after a move, a wait) therefore stay in the part of the motion
 before them. Instructions that are not written (skipped motions, see
-:attr:`olp.passes.resolve.Step.skipped`) count for nothing.
+:attr:`olp.compiled.Step.skipped`) count for nothing.
 
 Names: the main program keeps the program's name; part ``k`` of ``n`` is
 ``<name>_P<k>`` (``k`` zero-padded to the width of ``n``), the name cut so that the suffix fits
@@ -29,7 +29,7 @@ from olp.ir import Call, Instruction, Program, is_motion
 from olp.transforms.limits import LIMIT_KEYS, SplitLimits
 
 if TYPE_CHECKING:
-    from olp.passes.resolve import Step
+    from olp.compiled import Step
 
 __all__ = [
     "LIMIT_KEYS",

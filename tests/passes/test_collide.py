@@ -16,10 +16,11 @@ from olp.collision.advance import advance, path_run, sample_hits
 from olp.collision.chord import chord_deviation
 from olp.collision.scene import DisplacementBound, PairRules, Placed, Scene, build_scene
 from olp.collision.shapes import reach
+from olp.compiled import CompiledProgram
 from olp.diagnostics import Diagnostic
 from olp.geometry import pose_from, rotx, roty, rotz, transl
 from olp.passes.collide import Attachment, CollisionOptions, check_collisions
-from olp.passes.resolve import CompiledProgram, ResolveOptions, resolve
+from olp.passes.resolve import ResolveOptions, resolve
 from olp.station.loader import load_station
 from olp.station.model import Robot, Shape, Station, StationObject, ToolBody
 

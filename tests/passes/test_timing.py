@@ -30,11 +30,12 @@ import pytest
 from scipy.interpolate import CubicSpline
 
 from olp import ir
+from olp.compiled import CompiledProgram, Step
 from olp.geometry import rotation_log, rotz
 from olp.kinematics.opw import OPWParameters
 from olp.kinematics.pinocchio_model import TOOL0, build_model
 from olp.passes import timing
-from olp.passes.resolve import CompiledProgram, ResolveOptions, Step, resolve
+from olp.passes.resolve import ResolveOptions, resolve
 from olp.passes.timing import (
     DEFAULT_TIMES,
     ChainGeometry,
@@ -42,8 +43,10 @@ from olp.passes.timing import (
     joint_path,
     line_profiles,
     override_speeds,
+    ptp,
     ptp_duration,
     ptp_profile,
+    reachability,
     speed_sweep,
     straight_paths,
     tcp_rates,
@@ -389,7 +392,7 @@ def test_reachability_numpy_sweeps_and_ordered_pass_agree(
     """All stages by the ordered pass (0 numpy sweeps) or all by numpy sweeps: the same law."""
     where, moves = _cases(station, tool)["accel-limited LIN"]
     default = _compiled(where, tool, *moves)
-    monkeypatch.setattr(timing, "_VECTOR_SWEEPS", sweeps)
+    monkeypatch.setattr(reachability, "_VECTOR_SWEEPS", sweeps)
     other = _compiled(where, tool, *moves)
     assert other.steps[1].duration == pytest.approx(default.steps[1].duration, rel=1e-12)
 
@@ -535,7 +538,7 @@ def test_a_motion_that_cannot_be_timed_is_a_diagnostic(
     def fail(*args: object, **kwargs: object) -> None:
         raise timing.TimingError("no profile")
 
-    monkeypatch.setattr(timing, "ptp_profile", fail)
+    monkeypatch.setattr(ptp, "ptp_profile", fail)
     program = ir.Program(
         name="t", instructions=[ir.JointMove(target=ir.JointTarget(joints=Q0), tool=tool)]
     )
@@ -756,7 +759,7 @@ def test_any_ruckig_failure_is_a_timing_error(
         def calculate(self, *args: object) -> None:
             raise make_error()
 
-    monkeypatch.setattr(timing, "Ruckig", Failing)
+    monkeypatch.setattr(ptp, "Ruckig", Failing)
     with pytest.raises(timing.TimingError, match="Ruckig could not time the joint move"):
         ptp_profile(Q0, Q0 + 0.2, station.robot)
 

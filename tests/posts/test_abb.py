@@ -27,10 +27,10 @@ import pytest
 
 import olp
 from olp import ir
+from olp.compiled import CompiledProgram, Step
 from olp.diagnostics import Diagnostic
 from olp.kinematics.base import turn_variants
 from olp.kinematics.configuration import satisfies
-from olp.passes.resolve import CompiledProgram, Step
 from olp.posts import find_post
 from olp.posts.abb import PREDEFINED_NAMES, speed_name, speeddata, zone_name, zonedata
 from olp.posts.base import Post

@@ -27,6 +27,7 @@ import pytest
 
 import olp
 from olp.cli import main
+from olp.compiled import CompiledProgram, Step
 from olp.diagnostics import Diagnostic
 from olp.geometry import inv
 from olp.ir import (
@@ -51,7 +52,6 @@ from olp.ir import (
     is_motion,
 )
 from olp.kinematics.configuration import satisfies
-from olp.passes.resolve import CompiledProgram, Step
 from olp.posts import find_post
 from olp.posts.base import Post
 from olp.posts.fanuc import MAX_NAME_LENGTH, joint_percent, linear_mm_per_s, termination

@@ -24,12 +24,12 @@ import pytest
 
 import olp
 from olp import ir
+from olp.compiled import CompiledProgram, Step
 from olp.diagnostics import Diagnostic
 from olp.errors import PostError
 from olp.frontends.krl import load_krl
 from olp.kinematics.base import turn_variants
 from olp.kinematics.configuration import satisfies
-from olp.passes.resolve import CompiledProgram, Step
 from olp.posts import find_post
 from olp.posts.base import Post
 from olp.posts.kuka import NAME_RULE, krl_e6pos, krl_percent, krl_point_type

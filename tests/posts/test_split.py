@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from olp import ir
-from olp.passes.resolve import Step
+from olp.compiled import Step
 from olp.posts.abb import NAME_RULE as ABB_NAMES
 from olp.posts.kuka import NAME_RULE as KUKA_NAMES
 from olp.transforms.split import (

@@ -23,6 +23,7 @@ from hypothesis import strategies as st
 
 import olp
 from olp.cli import main
+from olp.compiled import CompiledProgram, Step
 from olp.diagnostics import Diagnostic
 from olp.geometry import inv, pose_from, rotation_exp, transl
 from olp.ir import (
@@ -46,7 +47,6 @@ from olp.ir import (
     Zone,
     is_motion,
 )
-from olp.passes.resolve import CompiledProgram, Step
 from olp.posts import find_post
 from olp.posts.base import Post
 from olp.posts.ur import MAX_MOTIONS, ur_joints

@@ -1,0 +1,52 @@
+"""A path problem: a chain's joint path on its grid with the TCP speed limits at the gridpoints,
+and the path-speed bounds that follow from them (what every path solver takes)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from olp.passes.timing.geometry import JointSpline
+from olp.passes.timing.plan import X_CAP
+from olp.passes.timing.tcp import rate_bound, tcp_rates
+from olp.station.model import Robot
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class PathProblem:
+    """One chain to time, rest to rest: its joint path, gridpoints ``grid`` (K,) and, at them,
+    the TCP's linear (m/s) and orientation (rad/s, ``inf``: none) speed limits (K,) each, for
+    the tool ``tool`` (4, 4) (TCP in flange). Joint limits are the robot's."""
+
+    path: JointSpline
+    grid: FloatArray
+    tool: FloatArray
+    linear: FloatArray
+    angular: FloatArray
+
+
+def speed_bounds(
+    robot: Robot,
+    q: FloatArray,
+    dq: FloatArray,
+    tools: FloatArray,
+    linear: FloatArray,
+    angular: FloatArray,
+) -> FloatArray:
+    """Upper bounds (K,) on the squared path speed ``x = (ds/dt)²`` at gridpoints where the path
+    is at ``q`` with tangent ``dq`` (K, dof), from the first-order limits: joint velocities
+    ``|q'_j| ds/dt <= v_j`` and the TCP speeds ``rate ds/dt <= limit`` (:func:`tcp_rates` for
+    ``tools`` (4, 4) or (K, 4, 4); ``linear`` m/s and ``angular`` rad/s (K,), ``inf``: none);
+    capped at ``X_CAP``."""
+    with np.errstate(divide="ignore"):
+        bound = np.min((robot.limits.velocity / np.abs(dq)) ** 2, axis=-1)
+    turns = bool(np.any(np.isfinite(angular)))
+    linear_rate, angular_rate = tcp_rates(robot, tools, q, dq, angular=turns)
+    bound = np.minimum(bound, rate_bound(linear_rate, linear))
+    if turns:
+        bound = np.minimum(bound, rate_bound(angular_rate, angular))
+    return np.minimum(bound, X_CAP)
