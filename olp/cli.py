@@ -16,7 +16,10 @@ from olp.commands import COMMANDS
 from olp.commands.common import EXIT_BAD_INPUT, EXIT_OK
 
 
-def _parser() -> argparse.ArgumentParser:
+def _parser(argv: Sequence[str]) -> argparse.ArgumentParser:
+    """The parser; only the command ``argv`` names gets its arguments, so that ``olp --help``
+    and a command do not build every other command's options (some come from the frontends)."""
+    chosen = next((arg for arg in argv if not arg.startswith("-")), None)
     parser = argparse.ArgumentParser(
         prog="olp",
         description="Offline-programming compiler for industrial robots: "
@@ -27,14 +30,22 @@ def _parser() -> argparse.ArgumentParser:
     for name in COMMANDS:
         module = importlib.import_module(f"olp.commands.{name}")
         command = sub.add_parser(module.NAME, help=module.HELP, description=module.HELP)
-        module.add_arguments(command)
+        if chosen == module.NAME:
+            module.add_arguments(command)
         command.set_defaults(run=module.run)
     return parser
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``olp`` console script; returns the exit code."""
-    parser = _parser()
+    from olp.errors import OlpError
+
+    argv = sys.argv[1:] if argv is None else list(argv)
+    try:
+        parser = _parser(argv)
+    except OlpError as exc:  # e.g. an installed frontend that fails to load
+        print(exc.format(), file=sys.stderr)
+        return EXIT_BAD_INPUT
     args = parser.parse_args(argv)
     if args.version:
         from importlib.metadata import version
@@ -44,8 +55,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.command is None:
         parser.print_help()
         return EXIT_BAD_INPUT
-    from olp.errors import OlpError
-
     try:
         return int(args.run(args))
     except OlpError as exc:

@@ -13,6 +13,7 @@ The timing tables of ``olp time`` (:func:`timing_summary`, :func:`timing_table`,
 from __future__ import annotations
 
 import json
+import os
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -103,9 +104,28 @@ def summary(result: BuildResult) -> str:
         ("diagnostics", f"{len(errors)} errors, {len(warnings)} warnings"),
     ]
     if result.written:
-        rows.append(("written", ", ".join(str(p) for p in result.written)))
+        rows.append(("written", written_line(result.written)))
     width = max(len(k) for k, _ in rows)
     return "\n".join(f"{k.ljust(width)}  {v}" for k, v in rows)
+
+
+WRITTEN_NAMED = 3
+"""How many written files the summary names; the others are counted (a split 1M-point program
+is hundreds of files)."""
+
+
+def written_line(paths: Sequence[Path]) -> str:
+    """The first :data:`WRITTEN_NAMED` paths, then how many more and the folder they are in:
+    ``out/P_1.src, out/P_1.dat, out/P_2.src and 397 more (400 files) in out/``."""
+    named = ", ".join(str(p) for p in paths[:WRITTEN_NAMED])
+    if len(paths) <= WRITTEN_NAMED:
+        return named
+    more = f"{named} and {len(paths) - WRITTEN_NAMED} more ({len(paths)} files)"
+    try:
+        folder = os.path.commonpath([os.fspath(p.parent) for p in paths])
+    except ValueError:  # absolute and relative paths, or several drives: no one folder
+        return more
+    return f"{more} in {os.path.join(folder, '')}"
 
 
 def _path_length(compiled: CompiledProgram) -> float:

@@ -12,6 +12,7 @@ import olp
 from olp import ir
 from olp.api import BuildResult
 from olp.cli import main
+from olp.frontends.bundled import CsvOptions, DslOptions
 from olp.station.model import Station
 
 REPO = Path(__file__).resolve().parents[1]
@@ -25,7 +26,7 @@ def station() -> Station:
 
 
 def build(station: Station, name: str, **params: object) -> BuildResult:
-    result = olp.build(station, EXAMPLES / name, params=params)
+    result = olp.build(station, EXAMPLES / name, program_options=DslOptions(params=params))
     assert result.ok, [d.format() for d in result.diagnostics if d.severity == "error"]
     return result
 
@@ -213,11 +214,9 @@ def test_job11_each_cup_picks_and_places_its_part(station: Station, cups: int) -
 def test_every_instruction_has_a_span_in_its_file(
     station: Station, name: str, options: dict[str, object]
 ) -> None:
-    from olp.frontends.csv import CsvOptions
-
     path = EXAMPLES / name
     csv = CsvOptions(**options) if name.endswith(".csv") else None  # type: ignore[arg-type]
-    program = olp.parse(path, station=station, csv_options=csv).program
+    program = olp.parse(path, station=station, options=csv).program
     lines = path.read_text(encoding="utf-8").split("\n")
     assert len(program) > 0
     for instruction in program:
@@ -235,10 +234,10 @@ def test_every_instruction_has_a_span_in_its_file(
     [
         ("path_xyz.csv", ["--orientation", "1,2"], "expected three angles in degrees"),
         ("path_xyz.csv", ["--orientation=-180,0,x"], "expected three angles in degrees"),
-        ("path_xyz.csv", ["--set", "A=1"], "--set parameters are for Python programs"),
+        ("path_xyz.csv", ["--set", "A=1"], "--set is for Python programs (.py), not .csv"),
         ("weld_polygon.py", ["--set", "1X=3"], "expected NAME=VALUE"),
         ("weld_polygon.py", ["--set", "SIDES=3", "--set", "SIDES=4"], "--set SIDES is given twice"),
-        ("weld_polygon.py", ["--frame", "table"], "CSV options are for .csv toolpaths"),
+        ("weld_polygon.py", ["--frame", "table"], "--frame is for CSV toolpaths (.csv), not .py"),
         ("path_xyz.csv", ["--euler", "xyx", "--tool", "torch"], "tool 'torch' is not in the"),
     ],
 )

@@ -6,7 +6,9 @@
     def run(args: argparse.Namespace) -> int: ...          # the exit code
 
 and is listed in :data:`COMMANDS`. Modules import heavy packages inside ``run`` only, so that
-``olp --help`` stays fast.
+``olp --help`` stays fast. The option groups several commands share (checks, collisions,
+outputs, the program and its frontend's options) are in :mod:`olp.commands.options`; the
+commands import it and :mod:`olp.commands.common`, never each other.
 """
 
 from __future__ import annotations

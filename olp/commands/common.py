@@ -1,17 +1,15 @@
-"""Helpers shared by the ``olp`` commands: exit codes, file checks, diagnostic printing."""
+"""Helpers shared by the ``olp`` commands: exit codes, file checks, diagnostic printing
+(their shared options are in :mod:`olp.commands.options`)."""
 
 from __future__ import annotations
 
-import argparse
 import sys
 from collections.abc import Iterable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from olp.api import ParsedProgram
     from olp.diagnostics import Diagnostic
-    from olp.station.model import Station
 
 EXIT_OK, EXIT_PROGRAM_ERRORS, EXIT_BAD_INPUT = 0, 1, 2
 
@@ -52,19 +50,3 @@ def _read_sources(paths: Iterable[str]) -> dict[str, str]:
         except OSError:
             continue
     return out
-
-
-def parse_program(args: argparse.Namespace, station: Station) -> ParsedProgram:
-    """Parse ``args.program`` with the program options of :mod:`olp.commands.build`
-    (``--set`` parameters, CSV options), the station at hand for DSL and CSV programs."""
-    from olp.api import parse
-    from olp.commands.build import csv_options, program_params
-
-    return parse(
-        args.program,
-        station=station,
-        params=program_params(args),
-        csv_options=csv_options(args),
-        krl_config_dat=args.config_dat,
-        timeout=args.timeout,
-    )

@@ -17,18 +17,15 @@ import sys
 from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING
 
-from olp.commands.check import (
+from olp.commands.common import EXIT_OK, EXIT_PROGRAM_ERRORS, print_diagnostics, require_files
+from olp.commands.options import (
     add_check_options,
     add_collision_options,
+    add_program,
+    add_program_options,
     collision_options,
-    resolve_options,
-)
-from olp.commands.common import (
-    EXIT_OK,
-    EXIT_PROGRAM_ERRORS,
     parse_program,
-    print_diagnostics,
-    require_files,
+    resolve_options,
 )
 from olp.errors import UsageError
 
@@ -44,9 +41,7 @@ OVERRIDABLE = ("set_output", "wait_input", "call", "comment")
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("station", help="station YAML file")
-    from olp.commands.build import PROGRAM_HELP
-
-    parser.add_argument("program", help=PROGRAM_HELP)
+    add_program(parser)
     parser.add_argument(
         "--sweep-linear",
         metavar="MM_S,...",
@@ -72,8 +67,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     add_check_options(parser)
     add_collision_options(parser)
-    from olp.commands.build import add_program_options
-
     add_program_options(parser)
     parser.add_argument(
         "-q", "--quiet", action="store_true", help="results only: no table, progress or warnings"

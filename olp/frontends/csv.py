@@ -55,7 +55,6 @@ from __future__ import annotations
 
 import dataclasses
 import io
-import math
 import os
 import re
 from collections.abc import Iterator, Mapping, Sequence
@@ -68,6 +67,8 @@ from numpy.typing import NDArray
 
 from olp import ir
 from olp.errors import ParseError, UsageError
+from olp.frontends.bundled import ANGLE_UNITS, LENGTH_UNITS
+from olp.frontends.bundled import CsvOptions as CsvOptions  # its home is light to import
 from olp.geometry import inv, pose_from, rotx, roty, rotz
 
 if TYPE_CHECKING:
@@ -83,12 +84,6 @@ LAYOUTS: dict[int, tuple[str, ...]] = {
     7: ("x", "y", "z", "a1", "a2", "a3", "index"),
 }
 """Column names by column count."""
-
-LENGTH_UNITS = {"mm": 1000.0, "m": 1.0, "in": 1.0 / 0.0254}
-"""Length units a CSV may use: how many make a metre (dividing keeps 9 mm exactly 0.009 m)."""
-ANGLE_UNITS = {"deg": math.pi / 180.0, "rad": 1.0}
-"""Angle units a CSV may use, in radians."""
-EULER_ALIASES = {"wpr": "xyz", "abc": "ZYX"}
 
 _DELIMITERS: tuple[str | None, ...] = (",", ";", "\t", "|", None)
 # Both patterns are linear in the text: no two adjacent repeats can match the same characters
@@ -106,77 +101,7 @@ the row is read as, so the target's name is the number in the file."""
 
 
 # ------------------------------------------------------------------------------------------------
-# Options and results
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class CsvOptions:
-    """How to read a CSV toolpath (see the module docstring). ``None`` means detect/default.
-
-    ``orientation``: three angles in degrees in the ``euler`` convention, for XYZ files.
-    ``speed`` (mm/s) and ``zone`` (mm) apply to every move. ``header``: number of header rows.
-    ``delimiter``: ``","``, ``";"``, ``"\\t"``, ``"|"`` or ``" "`` (any whitespace).
-    ``decimal``: ``"."`` or ``","``. ``units``: ``"mm"``, ``"m"`` or ``"in"``;
-    ``angle_units``: ``"deg"`` or ``"rad"``. ``chunk_bytes``: block size of the reader.
-    """
-
-    tool: str | None = None
-    frame: str | None = None
-    orientation: tuple[float, float, float] | None = None
-    euler: str = "xyz"
-    delimiter: str | None = None
-    decimal: str | None = None
-    header: int | None = None
-    units: str | None = None
-    angle_units: str | None = None
-    speed: float | None = None
-    zone: float = 0.0
-    chunk_bytes: int = 1 << 20
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "euler", euler_sequence(self.euler))
-        _check_choice("delimiter", self.delimiter, (",", ";", "\t", "|", " "))
-        _check_choice("decimal", self.decimal, (".", ","))
-        _check_choice("units", self.units, tuple(LENGTH_UNITS))
-        _check_choice("angle units", self.angle_units, tuple(ANGLE_UNITS))
-        if self.header is not None and self.header < 0:
-            raise UsageError(f"CSV header rows must be >= 0, got {self.header}")
-        if self.speed is not None and not (math.isfinite(self.speed) and self.speed > 0):
-            raise UsageError(f"CSV speed must be a positive number of mm/s, got {self.speed}")
-        if not (math.isfinite(self.zone) and self.zone >= 0):
-            raise UsageError(f"CSV zone must be >= 0 mm, got {self.zone}")
-        if self.orientation is not None:
-            values = tuple(float(v) for v in self.orientation)
-            if len(values) != 3 or not all(math.isfinite(v) for v in values):
-                raise UsageError(f"orientation needs three finite angles, got {self.orientation}")
-            object.__setattr__(self, "orientation", values)
-        if self.chunk_bytes < 1:
-            raise UsageError(f"chunk_bytes must be positive, got {self.chunk_bytes}")
-
-
-def _check_choice(what: str, value: str | None, allowed: tuple[str, ...]) -> None:
-    if value is not None and value not in allowed:
-        shown = ", ".join(repr(a) for a in allowed)
-        raise UsageError(f"CSV {what} {value!r} is not one of {shown}")
-
-
-def euler_sequence(text: str) -> str:
-    """A validated scipy-style Euler sequence (``"xyz"``, ``"ZYX"``, ``"ZYZ"``, ...) or alias."""
-    seq = EULER_ALIASES.get(text, text)
-    lowered = seq.lower()
-    valid = (
-        len(seq) == 3
-        and (seq.isupper() or seq.islower())
-        and set(lowered) <= set("xyz")
-        and lowered[0] != lowered[1]
-        and lowered[1] != lowered[2]
-    )
-    if not valid:
-        raise UsageError(
-            f"Euler sequence {text!r}: expected three axis letters such as 'xyz' (extrinsic) or "
-            "'ZYX' (intrinsic), or an alias: " + ", ".join(EULER_ALIASES)
-        )
-    return seq
+# Results
 
 
 @dataclass(frozen=True, slots=True)
@@ -288,8 +213,8 @@ def open_csv(path: str | os.PathLike[str], options: CsvOptions | None = None) ->
 def rotations_from_euler(sequence: str, angles: FloatArray) -> FloatArray:
     """Rotation matrices (n, 3, 3) from angles (n, 3) in radians, in file column order.
 
-    ``sequence`` as in :func:`euler_sequence`: intrinsic (upper case) composes the column
-    rotations left to right, extrinsic (lower case) right to left.
+    ``sequence`` as in :func:`olp.frontends.options.euler_sequence`: intrinsic (upper case)
+    composes the column rotations left to right, extrinsic (lower case) right to left.
     """
     makers = {"x": rotx, "y": roty, "z": rotz}
     mats = [makers[axis.lower()](angles[:, i])[:, :3, :3] for i, axis in enumerate(sequence)]

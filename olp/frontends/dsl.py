@@ -41,12 +41,8 @@ from typing import TYPE_CHECKING, Any
 
 from olp import dsl, ir
 from olp.errors import OlpError, ParseError, UsageError
-from olp.frontends.dsl_process import (
-    DEFAULT_TIMEOUT,
-    ProgramRunError,
-    check_timeout,
-    run_in_child,
-)
+from olp.frontends.bundled import DEFAULT_TIMEOUT, check_timeout
+from olp.frontends.dsl_process import ProgramRunError, run_in_child
 
 if TYPE_CHECKING:
     from olp.station.model import Station

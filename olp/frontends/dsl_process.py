@@ -37,7 +37,6 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
-import math
 import os
 import pickle
 import re
@@ -53,13 +52,11 @@ from typing import IO, TYPE_CHECKING, Any, NoReturn
 
 from olp import ir
 from olp.errors import OlpError, ParseError, PostError, StationError, UsageError
+from olp.frontends.bundled import DEFAULT_TIMEOUT, check_timeout
 
 if TYPE_CHECKING:
     from olp.frontends.dsl import DslResult
     from olp.station.model import Station
-
-DEFAULT_TIMEOUT = 60.0
-"""Seconds a Python program may run (``--timeout``), interpreter start included."""
 
 _REQUEST, _RESULT, _STACK, _CRASH, _EXIT = "request", "result", "stack", "crash", "exit"
 _DUMP_WAIT = 2.0
@@ -124,15 +121,6 @@ def run_in_child(
         _write_request(job, program, station, params)
         code = _run(job, limit)
         return _outcome(job, program, code, limit)
-
-
-def check_timeout(timeout: float | None) -> float | None:
-    """``timeout`` if it is a positive number of seconds (or None); a UsageError otherwise."""
-    if timeout is None:
-        return None
-    if isinstance(timeout, bool) or not isinstance(timeout, int | float) or not timeout > 0:
-        raise UsageError(f"--timeout must be a positive number of seconds, got {timeout!r}")
-    return None if math.isinf(timeout) else float(timeout)
 
 
 class _Program:

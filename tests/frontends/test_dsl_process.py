@@ -17,6 +17,7 @@ import pytest
 from olp import ir
 from olp.api import build, parse
 from olp.errors import OlpError, ParseError, UsageError
+from olp.frontends.bundled import DslOptions
 from olp.frontends.dsl import load_dsl, run_dsl
 from olp.frontends.dsl_process import ProgramRunError
 from olp.station.loader import load_station
@@ -102,9 +103,9 @@ def test_the_cli_takes_a_timeout(tmp_path: Path) -> None:
 def test_the_library_takes_a_timeout(tmp_path: Path, station: Station) -> None:
     path = program(tmp_path, HOME + "import time\ntime.sleep(60)\n")
     with pytest.raises(ProgramRunError, match="did not finish within 1 s"):
-        parse(path, station=station, timeout=1)
+        parse(path, station=station, options=DslOptions(timeout=1))
     with pytest.raises(ProgramRunError, match="did not finish within 1 s"):
-        build(station, path, timeout=1.0)
+        build(station, path, program_options=DslOptions(timeout=1.0))
 
 
 @pytest.mark.parametrize("value", ["0", "-1", "nan"])

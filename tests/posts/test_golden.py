@@ -44,13 +44,13 @@ USERS_JOBS: dict[str, tuple[str, str, dict[str, Any]]] = {
     "job3_csv_xyz": (
         KUKA_CELL,
         "examples/path_xyz.csv",
-        {"csv_options": CsvOptions(frame="table", orientation=(180.0, 0.0, 180.0))},
+        {"program_options": CsvOptions(frame="table", orientation=(180.0, 0.0, 180.0))},
     ),
     "job4_csv_xyzwpr": (
         KUKA_CELL,
         "examples/targets_xyzwpr.csv",
         {
-            "csv_options": CsvOptions(frame="table"),
+            "program_options": CsvOptions(frame="table"),
             "options": ResolveOptions(skip_unreachable=True),
         },
     ),

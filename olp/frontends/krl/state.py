@@ -211,7 +211,7 @@ class Context:
         if self.config is None:
             hints.append(
                 "XHOME, FHOME, PDEFAULT, TOOL_DATA and BASE_DATA are declared in the "
-                "controller's $config.dat: pass it (config_dat=...)"
+                "controller's $config.dat: pass it (--config-dat, or KrlOptions(config_dat=...))"
             )
         return Unknown(f"{name} is not declared in {self._where}", "; ".join(hints) or None)
 
