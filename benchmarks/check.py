@@ -28,9 +28,10 @@ from pathlib import Path
 import numpy as np
 
 from olp import ir
+from olp.compiled import CompiledProgram
 from olp.geometry import transl
 from olp.passes.collide import CollisionOptions, check_collisions_with_stats
-from olp.passes.resolve import CompiledProgram, resolve
+from olp.passes.resolve import resolve
 from olp.station.loader import load_station
 from olp.station.model import Station
 

@@ -30,7 +30,8 @@ from typing import Any
 import numpy as np
 
 from olp import ir
-from olp.passes.resolve import CompiledProgram, ResolveOptions, resolve
+from olp.compiled import CompiledProgram
+from olp.passes.resolve import ResolveOptions, resolve
 from olp.passes.timing import TimingOptions, time_program
 from olp.station.loader import load_station
 from olp.station.model import Station

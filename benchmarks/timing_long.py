@@ -32,7 +32,8 @@ import numpy as np
 
 from benchmarks.resolve import helix_program
 from olp import ir
-from olp.passes.resolve import CompiledProgram, resolve
+from olp.compiled import CompiledProgram
+from olp.passes.resolve import resolve
 from olp.passes.timing import TimingOptions, time_program
 from olp.station.loader import load_station
 from olp.trajectory import LineTimeLaw

@@ -53,11 +53,10 @@ expected; no other exception escapes for bad file content.
 
 from __future__ import annotations
 
-import dataclasses
 import io
 import os
 import re
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, BinaryIO
@@ -832,7 +831,9 @@ def _frame(name: str | None, station: Station | None) -> ir.Frame:
 
 
 class _ProgramBuilder:
-    """Turns chunks into IR moves; Speed, Zone, Tool and Frame objects are shared by rows."""
+    """Turns chunks into IR: the first row is a joint move (the robot must first get to the
+    path), every later chunk of rows one :class:`~olp.ir.LinearPath` (arrays, no object per
+    row), sharing the tool, frame and zone."""
 
     def __init__(self, stream: CsvStream, options: CsvOptions, station: Station | None) -> None:
         self.stream = stream
@@ -840,17 +841,15 @@ class _ProgramBuilder:
         self.layout = stream.layout
         self.tool = _tool(options.tool, station)
         self.frame = _frame(options.frame, station)
-        self.zone = ir.Zone(options.zone / 1000.0)
-        self.instructions: list[ir.Instruction] = []
-        self.speeds: dict[float, ir.Speed] = {}
+        self.zone = options.zone / 1000.0
+        self.nodes: list[ir.Node] = []
         has_angles = len(self.layout.columns) >= 6
         if has_angles and options.orientation is not None:
             raise UsageError(
                 "an orientation option is for XYZ files; this file has angles in every row"
             )
         self.rotation = None if has_angles else self._fixed_rotation(station)
-        default = ir.Speed() if options.speed is None else ir.Speed(linear=options.speed / 1e3)
-        self.default_speed = default
+        self.default_speed = 0.25 if options.speed is None else options.speed / 1e3
 
     def _fixed_rotation(self, station: Station | None) -> FloatArray:
         if self.options.orientation is not None:
@@ -870,23 +869,46 @@ class _ProgramBuilder:
 
     def add(self, chunk: CsvChunk) -> None:
         poses = self._poses(chunk)
-        speeds = self._speed_objects(chunk)
-        names = self._names(chunk)
-        filename = self.stream.filename
-        for k in range(chunk.lines.size):
-            line = int(chunk.lines[k])
-            first = not self.instructions
-            move = ir.JointMove if first else ir.LinearMove
-            self.instructions.append(
-                move(
-                    target=ir.CartesianTarget(pose=poses[k], name=names[k] if names else None),
-                    speed=speeds[k],
-                    zone=ir.FINE if first else self.zone,
-                    tool=self.tool,
-                    frame=self.frame,
-                    span=ir.SourceSpan(filename, line, 1, line, int(chunk.lengths[k]) + 1),
-                )
+        speeds = self._speeds(chunk)
+        labels = self._labels(chunk)
+        lines, widths = chunk.lines, chunk.lengths
+        if not self.nodes:
+            self.nodes.append(self._first(poses[0], speeds[0], labels, lines[0], widths[0]))
+            poses, speeds, lines, widths = poses[1:], speeds[1:], lines[1:], widths[1:]
+            labels = None if labels is None else labels[1:]
+        if lines.size == 0:
+            return
+        self.nodes.append(
+            ir.LinearPath(
+                poses=poses,
+                speeds=speeds,
+                zones=np.full(lines.size, self.zone),
+                lines=lines,
+                tool=self.tool,
+                frame=self.frame,
+                source=self.stream.filename,
+                widths=widths,
+                labels=labels,
             )
+        )
+
+    def _first(
+        self,
+        pose: FloatArray,
+        speed: float,
+        labels: IntArray | None,
+        line: int,
+        width: int,
+    ) -> ir.JointMove:
+        name = None if labels is None else str(int(labels[0]))
+        span = ir.SourceSpan(self.stream.filename, int(line), 1, int(line), int(width) + 1)
+        return ir.JointMove(
+            target=ir.CartesianTarget(pose=pose, name=name),
+            speed=ir.Speed(linear=float(speed)),
+            tool=self.tool,
+            frame=self.frame,
+            span=span,
+        )
 
     def _poses(self, chunk: CsvChunk) -> FloatArray:
         values = chunk.values
@@ -898,26 +920,27 @@ class _ProgramBuilder:
             rotation = rotations_from_euler(self.options.euler, angles)
         return pose_from(rotation, position)
 
-    def _speed_objects(self, chunk: CsvChunk) -> Sequence[ir.Speed]:
+    def _speeds(self, chunk: CsvChunk) -> FloatArray:
+        """Speeds (n,) m/s: the speed column, or the default for every row."""
         if "speed" not in self.layout.columns:
-            return [self.default_speed] * chunk.lines.size
-        speeds = chunk.values[:, self.layout.columns.index("speed")] / self.layout.speed_divisor
-        return [self._speed(v) for v in speeds.tolist()]
+            return np.full(chunk.lines.size, self.default_speed)
+        speeds: FloatArray = (
+            chunk.values[:, self.layout.columns.index("speed")] / self.layout.speed_divisor
+        )
+        return speeds
 
-    def _speed(self, value: float) -> ir.Speed:
-        speed = self.speeds.get(value)
-        if speed is None:
-            speed = self.speeds[value] = ir.Speed(linear=value)
-        return speed
-
-    def _names(self, chunk: CsvChunk) -> list[str] | None:
+    def _labels(self, chunk: CsvChunk) -> IntArray | None:
+        """The index column as integer target names (n,), or None."""
         if "index" not in self.layout.columns:
             return None
-        return [str(int(v)) for v in chunk.values[:, -1].tolist()]
+        labels: IntArray = chunk.values[:, -1].astype(np.int64)
+        return labels
 
     def program(self, name: str) -> ir.Program:
-        moves = self.instructions
-        last = moves[-1] if moves else None
-        if isinstance(last, ir.LinearMove) and not last.zone.is_fine:
-            moves[-1] = dataclasses.replace(last, zone=ir.FINE)
-        return ir.Program(name=name, instructions=tuple(moves), source=self.stream.filename)
+        """The program; the robot stops at the last row."""
+        last = self.nodes[-1] if self.nodes else None
+        if isinstance(last, ir.LinearPath) and last.zones[-1] > 0:
+            zones = last.zones.copy()
+            zones[-1] = 0.0
+            self.nodes[-1] = last.with_zones(zones)
+        return ir.Program(name=name, instructions=tuple(self.nodes), source=self.stream.filename)

@@ -191,9 +191,12 @@ def test_job3_moves_speeds_spans_and_zones() -> None:
         "0,0,100,250", "0,0,6.35,20", "276.225,0,6.35,21.17", "276.225,323.85,6.35,21.17",
         "0,0,106.35,250",
     )]  # fmt: skip
-    # Every row keeps its exact speed (mm/s -> m/s by division), equal values share one object.
+    # Every row keeps its exact speed (mm/s -> m/s by division).
     assert [m.speed.linear for m in moves] == [0.25, 0.02, 0.02117, 0.02117, 0.25]
-    assert moves[2].speed is moves[3].speed
+    # The rows after the first are one dense toolpath node: arrays, no object per row.
+    first, path = result.program.instructions
+    assert isinstance(first, ir.JointMove) and isinstance(path, ir.LinearPath)
+    assert path.speeds.tolist() == [0.02, 0.02117, 0.02117, 0.25] and len(result.program) == 5
     # The joint move and the last move stop exactly; the linear moves between are rounded.
     assert [m.zone.radius for m in moves] == [0.0, 0.002, 0.002, 0.002, 0.0]
     assert result.program.name == "t" and result.program.source == "t.csv"
