@@ -23,6 +23,7 @@ from olp.compiled import CompiledProgram, PathBlock, RowTrajectories, Step, item
 from olp.compiled import span_of as _span
 from olp.diagnostics import Diagnostic
 from olp.ir import is_motion
+from olp.passes.timing import ptp
 from olp.passes.timing.chains import PATH_SOLVERS, path_problem, time_law
 from olp.passes.timing.geometry import joined_geometry
 from olp.passes.timing.lines import line_profiles, straight_samples
@@ -33,7 +34,6 @@ from olp.passes.timing.plan import (
     fixed_time,
     time_table,
 )
-from olp.passes.timing import ptp
 from olp.passes.timing.table import (
     COMMENT,
     FIXED,
