@@ -246,6 +246,13 @@ class CompiledProgram:
                 index += 1
         return cls(program, station, station.robot.home.copy(), make_steps(items))
 
+    def flat(self) -> CompiledProgram:
+        """A copy whose steps are a tuple, a toolpath's rows made into steps once (for code that
+        walks the steps several times, such as a post's templates)."""
+        if isinstance(self.steps, tuple):
+            return self
+        return dataclasses.replace(self, steps=tuple(self.steps))
+
     def with_diagnostics(self, found: Iterable[Diagnostic]) -> CompiledProgram:
         """A copy with ``found`` appended to the diagnostics."""
         return dataclasses.replace(self, diagnostics=self.diagnostics + tuple(found))

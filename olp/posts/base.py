@@ -183,6 +183,7 @@ class Post:
     def check(self, compiled: CompiledProgram) -> list[Diagnostic]:
         """Everything this post reports about ``compiled``; errors mean nothing is written."""
         out = self._foreign_robot(compiled)
+        compiled = compiled.flat()
         for step in compiled.steps:
             out += self._shared_checks(step)
             out += self.check_instruction(step, compiled)
@@ -194,7 +195,8 @@ class Post:
         it is), so the text never depends on whether the caller prepared the program."""
         from olp.posts.render import render
 
-        return render(self.prepare(compiled)[0], self, name)
+        # The templates walk the steps row by row several times: make a toolpath's rows once.
+        return render(self.prepare(compiled)[0].flat(), self, name)
 
     def write(self, files: Mapping[str, str], folder: Path) -> list[Path]:
         """Encode every file in the manifest's encoding (a character it lacks is a PostError
