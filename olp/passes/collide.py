@@ -54,6 +54,7 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 from numpy.typing import NDArray
 
+from olp import progress
 from olp.compiled import PathBlock, Step, items_of
 from olp.diagnostics import Diagnostic
 from olp.errors import UsageError
@@ -179,6 +180,7 @@ def check_collisions_with_stats(
     stats = CollisionStats()
     for run in runs:
         hits, failed, run_stats = _check_run(run, opts)
+        progress.advance(sum(len(p) if isinstance(p, PathBlock) else 1 for p in run.parts))
         found.extend(hits)
         unresolved.extend(failed)
         stats = CollisionStats(

@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from olp import progress
 from olp.compiled import CompiledProgram, Item, PathBlock, Step, StepBlocks, make_steps
 from olp.diagnostics import Diagnostic
 from olp.geometry import interpolate_poses, inv, pose_distance
@@ -110,6 +111,7 @@ def resolve(
             items.extend(found_items)
             diags.extend(found)
             index, flat = index + 1, flat + len(node)
+            progress.advance(len(node))
             continue
         run = _linear_run(nodes, index, flat, station)
         if run:
@@ -117,6 +119,7 @@ def resolve(
             items.extend(found_items)
             diags.extend(found)
             index, flat = index + len(run), flat + len(run)
+            progress.advance(len(run))
             continue
         if isinstance(node, MOTION_TYPES):
             step, found = _resolve_motion(flat, node, station, state)
@@ -125,6 +128,7 @@ def resolve(
         else:
             items.append(Step(index=flat, instruction=node))
         index, flat = index + 1, flat + 1
+        progress.advance(1)
     steps = make_steps(items)
     if isinstance(steps, StepBlocks):
         program = program.replace_instructions([_node_of(item) for item in steps.blocks])
