@@ -91,6 +91,33 @@ class State:
     cdis_mm: float | None = None
     tool: ir.Tool = field(default_factory=lambda: ir.FLANGE)
     frame: ir.Frame = field(default_factory=lambda: ir.WORLD)
+    ori_type: str = "VAR"  # $ORI_TYPE: VAR, CONSTANT or JOINT
+    circ_type: str = "BASE"  # $CIRC_TYPE: BASE or PATH
+
+    @property
+    def arc_orientation(self) -> ir.ArcOrientation:
+        """The orientation rule of a CIRC under this state (see :data:`ARC_ORIENTATIONS`)."""
+        return ARC_ORIENTATIONS[(self.ori_type, self.circ_type)]
+
+
+ARC_ORIENTATIONS = {
+    ("VAR", "BASE"): ir.ArcOrientation.INTERPOLATE,
+    ("CONSTANT", "BASE"): ir.ArcOrientation.CONSTANT,
+    ("VAR", "PATH"): ir.ArcOrientation.PATH,
+    ("CONSTANT", "PATH"): ir.ArcOrientation.PATH_CONSTANT,
+    ("JOINT", "BASE"): ir.ArcOrientation.WRIST,
+    ("JOINT", "PATH"): ir.ArcOrientation.WRIST,
+}
+"""KUKA ``($ORI_TYPE, $CIRC_TYPE)`` -> olp's arc orientation rule. ``#VAR`` interpolates the
+orientation from the start to the end point, ``#CONSTANT`` keeps the start's, ``#JOINT``
+interpolates the wrist axes; ``#BASE`` refers the orientation to the base, ``#PATH`` to the
+path (it turns with the arc). Defaults ``#VAR`` and ``#BASE`` (the inline forms' LDAT default
+``ORI_TYP #VAR, CIRC_TYP #BASE``). Sources: KUKA knowledge-base articles on ``$ORI_TYPE`` and
+``$CIRC_TYPE`` and the KSS inline forms' LDAT (medium confidence); how olp models each rule:
+:mod:`olp.arcs`."""
+
+ORI_TYPES = frozenset({"VAR", "CONSTANT", "JOINT"})
+CIRC_TYPES = frozenset({"BASE", "PATH"})
 
 
 @dataclass(slots=True)
@@ -150,8 +177,7 @@ SYSTEM_REASONS = {
     "$ACC.CP": "path acceleration ($ACC.CP) is not part of olp's IR",
     "$ACC": "path acceleration ($ACC) is not part of olp's IR",
     "$ADVANCE": "the advance run does not change the path",
-    "$ORI_TYPE": "the orientation control type is not lowered (olp interpolates orientation)",
-    "$CIRC_TYPE": "the orientation control type of CIRC is not lowered",
+    "$CIRC_MODE": "$CIRC_MODE is not lowered: olp ignores the auxiliary point's orientation",
     "$LOAD": "payload data are not part of olp's IR",
     "$GEAR_JERK[]": "gear jerk limits are not part of olp's IR",
     "$JERK": "jerk limits are not part of olp's IR",
@@ -268,6 +294,8 @@ class Core:
             "$OUT[]": self._set_output,
             "$H_POS": self._set_home,
             "$IPO_MODE": self._set_ipo_mode,
+            "$ORI_TYPE": self._set_ori_type,
+            "$CIRC_TYPE": self._set_circ_type,
         }
 
     # ---- reporting
@@ -434,6 +462,24 @@ class Core:
 
     def _set_ipo_mode(self, name: str, value: Expr, stmt: Stmt) -> None:
         self._ipo_mode(self._value(value), value.span)
+
+    def _set_ori_type(self, name: str, value: Expr, stmt: Stmt) -> None:
+        self._orientation_type("$ORI_TYPE", self._value(value), value.span)
+
+    def _set_circ_type(self, name: str, value: Expr, stmt: Stmt) -> None:
+        self._orientation_type("$CIRC_TYPE", self._value(value), value.span)
+
+    def _orientation_type(self, name: str, value: Value, span: ir.SourceSpan) -> None:
+        """``$ORI_TYPE`` (#VAR, #CONSTANT, #JOINT) or ``$CIRC_TYPE`` (#BASE, #PATH)."""
+        allowed = ORI_TYPES if name == "$ORI_TYPE" else CIRC_TYPES
+        found = value.name.upper() if isinstance(value, EnumValue) else None
+        if found not in allowed:
+            names = ", ".join(f"#{a}" for a in sorted(allowed))
+            raise self._error(
+                f"{name} must be one of {names}, found {self.sources.snippet(span)!r}", span
+            )
+        field_name = "ori_type" if name == "$ORI_TYPE" else "circ_type"
+        self.state = dataclasses.replace(self.state, **{field_name: found})
 
     def _ipo_mode(self, mode: Value, span: ir.SourceSpan) -> None:
         if isinstance(mode, EnumValue) and mode.name.upper() == "BASE":
