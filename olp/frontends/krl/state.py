@@ -478,8 +478,10 @@ class Core:
             raise self._error(
                 f"{name} must be one of {names}, found {self.sources.snippet(span)!r}", span
             )
-        field_name = "ori_type" if name == "$ORI_TYPE" else "circ_type"
-        self.state = dataclasses.replace(self.state, **{field_name: found})
+        if name == "$ORI_TYPE":
+            self.state = dataclasses.replace(self.state, ori_type=found)
+        else:
+            self.state = dataclasses.replace(self.state, circ_type=found)
 
     def _ipo_mode(self, mode: Value, span: ir.SourceSpan) -> None:
         if isinstance(mode, EnumValue) and mode.name.upper() == "BASE":
