@@ -174,7 +174,7 @@ class Motions(InlineForms):
 
     def _arc_fields(self, stmt: MotionStmt) -> dict[str, Any]:
         """A CIRC's circular angle (``CA``, degrees, signed, not 0) and orientation rule (the
-        state's ``$ORI_TYPE`` and ``$CIRC_TYPE``, :data:`olp.frontends.krl.state.ARC_ORIENTATIONS`).
+        state's ``$ORI_TYPE`` and ``$CIRC_TYPE``, :data:`olp.vendors.kuka.ARC_ORIENTATIONS`).
         SCIRC follows the same rules in olp (its ``$CIRC_MODE`` is not modelled: noted)."""
         fields: dict[str, Any] = {"orientation": self.state.arc_orientation}
         if stmt.keyword == "SCIRC":

@@ -55,7 +55,7 @@ from olp.frontends.krl.values import (
     as_number,
     frame_values,
 )
-from olp.vendors.kuka import frame_to_pose
+from olp.vendors.kuka import ARC_ORIENTATIONS, frame_to_pose
 
 DEFAULT_VEL_CP = 2.0
 """m/s: ``$VEL.CP`` assumed before the program sets it (what ``BAS(#INITMOV, 0)`` is reported to
@@ -96,25 +96,9 @@ class State:
 
     @property
     def arc_orientation(self) -> ir.ArcOrientation:
-        """The orientation rule of a CIRC under this state (see :data:`ARC_ORIENTATIONS`)."""
+        """The rule of a CIRC under this state (:data:`olp.vendors.kuka.ARC_ORIENTATIONS`)."""
         return ARC_ORIENTATIONS[(self.ori_type, self.circ_type)]
 
-
-ARC_ORIENTATIONS = {
-    ("VAR", "BASE"): ir.ArcOrientation.INTERPOLATE,
-    ("CONSTANT", "BASE"): ir.ArcOrientation.CONSTANT,
-    ("VAR", "PATH"): ir.ArcOrientation.PATH,
-    ("CONSTANT", "PATH"): ir.ArcOrientation.PATH_CONSTANT,
-    ("JOINT", "BASE"): ir.ArcOrientation.WRIST,
-    ("JOINT", "PATH"): ir.ArcOrientation.WRIST,
-}
-"""KUKA ``($ORI_TYPE, $CIRC_TYPE)`` -> olp's arc orientation rule. ``#VAR`` interpolates the
-orientation from the start to the end point, ``#CONSTANT`` keeps the start's, ``#JOINT``
-interpolates the wrist axes; ``#BASE`` refers the orientation to the base, ``#PATH`` to the
-path (it turns with the arc). Defaults ``#VAR`` and ``#BASE`` (the inline forms' LDAT default
-``ORI_TYP #VAR, CIRC_TYP #BASE``). Sources: KUKA knowledge-base articles on ``$ORI_TYPE`` and
-``$CIRC_TYPE`` and the KSS inline forms' LDAT (medium confidence); how olp models each rule:
-:mod:`olp.arcs`."""
 
 ORI_TYPES = frozenset({"VAR", "CONSTANT", "JOINT"})
 CIRC_TYPES = frozenset({"BASE", "PATH"})
