@@ -613,7 +613,8 @@ class Robot:
 
         A joint speed (deg/s) becomes the fraction of the axis limits that keeps every axis at
         or below it: ``deg/s / fastest axis limit`` (olp's IR has one fraction for all axes).
-        A linear acceleration is not modelled by olp and is noted.
+        A linear acceleration (mm/s²) is the TCP path acceleration limit of linear and circular
+        moves (``Speed.linear_acceleration``, m/s²), as RoboDK's ``setAcceleration``.
         """
         values = _finite([speed_linear, speed_joints, accel_linear, accel_joints], "setSpeed")
         linear, joint, accel, joint_accel = values
@@ -627,7 +628,8 @@ class Robot:
                 joint_accel, "acceleration", "setSpeed: joint acceleration (deg/s²)"
             )
         if accel >= 0:
-            self._s.ignore("a linear acceleration is not modelled by olp; ignored")
+            accel_si = _positive(accel, "setSpeed: linear acceleration (mm/s²)") / 1000.0
+            changes["linear_acceleration"] = accel_si
         self._speed = _replace_speed(self._speed, changes)
         return self
 
@@ -636,7 +638,7 @@ class Robot:
         return self.setSpeed(-1, speed_joints)
 
     def setAcceleration(self, accel_linear: float) -> Robot:
-        """Linear acceleration in mm/s² (not modelled: noted)."""
+        """Linear (TCP path) acceleration in mm/s² (see :meth:`setSpeed`)."""
         return self.setSpeed(-1, -1, accel_linear)
 
     def setAccelerationJoints(self, accel_joints: float) -> Robot:

@@ -213,12 +213,18 @@ class Speed:
     ``joint``: fraction (0, 1] of each axis' maximum velocity for joint moves.
     ``angular``: optional TCP orientation speed limit for linear/circular moves, rad/s.
     ``joint_acceleration``: fraction (0, 1] of each axis' maximum acceleration.
+    ``linear_acceleration``: optional TCP path acceleration limit for linear/circular moves,
+    m/s² (KUKA ``$ACC.CP``, ABB ``PathAccLim``, UR ``movel`` ``a``); None: the controller's own.
+    ``angular_acceleration``: optional TCP orientation acceleration limit, rad/s² (KUKA
+    ``$ACC.ORI1``); None: the controller's own.
     """
 
     linear: float = 0.25
     joint: float = 1.0
     angular: float | None = None
     joint_acceleration: float = 1.0
+    linear_acceleration: float | None = None
+    angular_acceleration: float | None = None
 
     def __post_init__(self) -> None:
         if not (np.isfinite(self.linear) and self.linear > 0):
@@ -227,8 +233,14 @@ class Speed:
             value = getattr(self, name)
             if not (np.isfinite(value) and 0 < value <= 1):
                 raise IRError(f"Speed.{name} must be in (0, 1], got {value}")
-        if self.angular is not None and not (np.isfinite(self.angular) and self.angular > 0):
-            raise IRError(f"Speed.angular must be > 0 rad/s, got {self.angular}")
+        for name, unit in (
+            ("angular", "rad/s"),
+            ("linear_acceleration", "m/s²"),
+            ("angular_acceleration", "rad/s²"),
+        ):
+            value = getattr(self, name)
+            if value is not None and not (np.isfinite(value) and value > 0):
+                raise IRError(f"Speed.{name} must be > 0 {unit}, got {value}")
 
 
 @dataclass(frozen=True, slots=True)
@@ -269,8 +281,11 @@ class _Motion:
         joint: float | None = None,
         angular: float | None = None,
         joint_acceleration: float | None = None,
+        linear_acceleration: float | None = None,
+        angular_acceleration: float | None = None,
     ) -> Self:
-        """A copy with the given speed parts changed (m/s, fractions, rad/s); the others kept.
+        """A copy with the given speed parts changed (m/s, fractions, rad/s, m/s², rad/s²); the
+        others kept.
 
         ``move.with_speed(linear=min(move.speed.linear, 0.1))`` caps the TCP speed at 100 mm/s.
         """
@@ -281,6 +296,8 @@ class _Motion:
                 ("joint", joint),
                 ("angular", angular),
                 ("joint_acceleration", joint_acceleration),
+                ("linear_acceleration", linear_acceleration),
+                ("angular_acceleration", angular_acceleration),
             )
             if value is not None
         }
@@ -442,7 +459,9 @@ class LinearPath:
     ``zones`` (N,) m (0: a fine stop); ``lines`` (N,) the 1-based source line of each row in
     ``source``, and ``widths`` (N,) its length in characters (for a located message), or None;
     ``labels`` (N,) integer target names (a CSV index column), or None; ``angular`` the TCP
-    orientation speed limit of every row, rad/s, or None.
+    orientation speed limit of every row, rad/s, or None; ``acceleration`` and
+    ``angular_acceleration`` the TCP path and orientation acceleration limits of every row,
+    m/s² and rad/s², or None (see :class:`Speed`).
 
     All rows are validated at once when the node is made (finite, rigid rotations, speeds > 0,
     zones >= 0). Row ``k`` as an ordinary instruction is :meth:`move` ``(k)``; iterating the node
@@ -456,6 +475,8 @@ class LinearPath:
     tool: Tool = field(default_factory=lambda: FLANGE)
     frame: Frame = field(default_factory=lambda: WORLD)
     angular: float | None = None
+    acceleration: float | None = None
+    angular_acceleration: float | None = None
     source: str = "<memory>"
     widths: IntArray | None = None
     labels: IntArray | None = None
@@ -473,8 +494,10 @@ class LinearPath:
             raise IRError(f"LinearPath.speeds must be > 0 m/s (row {int(np.argmin(speeds))})")
         if np.any(zones < 0):
             raise IRError(f"LinearPath.zones must be >= 0 m (row {int(np.argmin(zones))})")
-        if self.angular is not None and not (np.isfinite(self.angular) and self.angular > 0):
-            raise IRError(f"LinearPath.angular must be > 0 rad/s, got {self.angular}")
+        for name in ("angular", "acceleration", "angular_acceleration"):
+            value = getattr(self, name)
+            if value is not None and not (np.isfinite(value) and value > 0):
+                raise IRError(f"LinearPath.{name} must be > 0, got {value}")
         object.__setattr__(self, "poses", poses)
         object.__setattr__(self, "speeds", speeds)
         object.__setattr__(self, "zones", zones)
@@ -507,7 +530,9 @@ class LinearPath:
         name = None if self.labels is None else str(int(self.labels[k]))
         return LinearMove(
             target=CartesianTarget.trusted(self.poses[k], name),
-            speed=_row_speed(float(self.speeds[k]), self.angular),
+            speed=_row_speed(
+                float(self.speeds[k]), self.angular, self.acceleration, self.angular_acceleration
+            ),
             zone=Zone(float(self.zones[k])),
             tool=self.tool,
             frame=self.frame,
@@ -537,7 +562,12 @@ class LinearPath:
         return dataclasses.replace(self, zones=np.broadcast_to(zones, self.zones.shape))
 
 
-def _row_speed(linear: float, angular: float | None) -> Speed:
+def _row_speed(
+    linear: float,
+    angular: float | None,
+    acceleration: float | None = None,
+    angular_acceleration: float | None = None,
+) -> Speed:
     """A Speed of a validated row (no second check)."""
     speed = object.__new__(Speed)
     for name, value in (
@@ -545,6 +575,8 @@ def _row_speed(linear: float, angular: float | None) -> Speed:
         ("joint", 1.0),
         ("angular", angular),
         ("joint_acceleration", 1.0),
+        ("linear_acceleration", acceleration),
+        ("angular_acceleration", angular_acceleration),
     ):
         object.__setattr__(speed, name, value)
     return speed

@@ -27,6 +27,14 @@ the confidence given:
   circular angle (the base post's ``arc_orientation`` / ``arc_angle`` errors).
   ``ConfJ \\On`` / ``ConfL \\On`` make the controller take the written confdata. Joint moves are
   limited by the speeddata's TCP speed: RAPID has no joint speed fraction (warned).
+* ``Speed.linear_acceleration`` (m/s²) as ``PathAccLim TRUE \\AccMax:=a, TRUE \\DecelMax:=a;``
+  before the path move where it changes, and ``PathAccLim FALSE, FALSE;`` where it is unset
+  again or before a joint move (olp's estimate limits only path moves with it). PathAccLim
+  limits the TCP's acceleration and deceleration *along the path* in m/s², at least 0.1 m/s²
+  (RAPID reference, PathAccLim, as summarised in a public RAPID tutorial: medium confidence).
+  ``AccSet Acc, Ramp`` (percent of an unpublished maximum) is not written: a value in m/s²
+  cannot be mapped to it honestly. The orientation acceleration has no RAPID counterpart
+  (the base post warns).
 * ``SetDO signal, 0|1;``, ``WaitDI signal, 0|1;`` (I/O by configured signal name:
   :func:`rapid_signal`), ``WaitTime \\InPos, t;`` (the dwell starts once the robot stands
   still, like KRL's ``WAIT SEC``), ``Name args;`` procedure calls, ``!`` comments.
@@ -125,6 +133,7 @@ NUMBERS: Mapping[str, NumberFormat] = {
     "zone": NumberFormat("zone size", "mm or deg", 3, low=0.0, storage=_NUM, compact=True),
     "mass": NumberFormat("tool mass", "kg", 3, low=0.0, low_open=True, storage=_NUM, compact=True),
     "wait": NumberFormat("dwell WaitTime", "s", 3, low=0.0, storage=_NUM, resolution=0.01),
+    "path_acc": NumberFormat("path acceleration PathAccLim", "m/s²", 3, low=0.1, storage=_NUM),
 }
 """How the RAPID post writes each quantity (printed units)."""
 
@@ -261,6 +270,7 @@ class AbbPost(Post):
         one_of(NUMBER, r'"[^"\\\x00-\x1f\x7f-\x9f\u2028\u2029]{0,80}"', IDENTIFIER),
         'numbers, names, "strings" of at most 80 characters without " or \\',
     )
+    ACCELERATIONS: ClassVar[frozenset[str]] = frozenset({"linear_acceleration"})
     NUMBERS: ClassVar[Mapping[str, NumberFormat]] = NUMBERS
     FILTERS: ClassVar[Mapping[str, Filter]] = FILTERS
     NULL_TOOL_NAME = NULL_TOOL_NAME

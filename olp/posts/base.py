@@ -139,6 +139,11 @@ class Post:
     move's line, never a different path."""
     ARC_ANGLE: ClassVar[bool] = False
     """Whether a circular move's circular angle (KUKA's CA) can be written."""
+    ACCELERATIONS: ClassVar[frozenset[str]] = frozenset()
+    """The path-move acceleration limits of :class:`olp.ir.Speed` this language can write
+    (``"linear_acceleration"``, ``"angular_acceleration"``); one it cannot is a warning on the
+    first move that sets it (the robot then runs with the controller's own value, and the
+    cycle time differs from the estimate)."""
 
     def __init__(self, manifest: PostManifest) -> None:
         self.manifest = manifest
@@ -194,7 +199,30 @@ class Post:
         for step in compiled.steps:
             out += self._shared_checks(step)
             out += self.check_instruction(step, compiled)
-        return out + self.check_program(compiled)
+        return out + self._acceleration_checks(compiled.steps) + self.check_program(compiled)
+
+    def _acceleration_checks(self, steps: Sequence[Step]) -> list[Diagnostic]:
+        """One warning per acceleration limit the program sets on path moves and this
+        language cannot write (:attr:`ACCELERATIONS`), on the first such move's line."""
+        out = []
+        for name in ("linear_acceleration", "angular_acceleration"):
+            if name in self.ACCELERATIONS:
+                continue
+            moves = [
+                step
+                for step in steps
+                if step.instruction.kind in ("linear", "circular")
+                and getattr(step.instruction.speed, name) is not None
+            ]
+            if moves:
+                what = _ACCELERATION_NAMES[name]
+                msg = (
+                    f"the {self.LANGUAGE} post cannot write the {what} set on "
+                    f"{len(moves)} path move(s): the controller's own applies, and the cycle "
+                    "time differs from the estimate"
+                )
+                out.append(_warning("acceleration", msg, moves[0]))
+        return out
 
     def render(self, compiled: CompiledProgram, name: str | None = None) -> dict[str, str]:
         """Every file of the program (:func:`olp.posts.render.render`), after the
@@ -391,8 +419,18 @@ def _bind(fn: Filter, post: Post) -> Filter:
     return bound
 
 
+_ACCELERATION_NAMES = {
+    "linear_acceleration": "TCP path acceleration",
+    "angular_acceleration": "orientation acceleration",
+}
+
+
 def _error(kind: str, message: str, step: Step, hint: str | None = None) -> Diagnostic:
     return Diagnostic("error", kind, message, step.instruction.span, step.index, hint=hint)
+
+
+def _warning(kind: str, message: str, step: Step) -> Diagnostic:
+    return Diagnostic("warning", kind, message, step.instruction.span, step.index)
 
 
 def _quote(text: str, limit: int = 60) -> str:

@@ -30,6 +30,11 @@ files ``tests/golden/kuka/``.
   ``$ACC_AXIS[i]`` in whole percent 1..100 (:data:`VEL_AXIS_MIN_PERCENT`, medium confidence);
   approximation ``C_DIS`` with ``$APO.CDIS`` (mm), ``C_PTP`` with ``$APO.CPTP`` (INT, 1..100 %:
   KUKA's mxAutomation manual describes the APO structure so, medium confidence).
+  ``Speed.linear_acceleration`` as ``$ACC.CP`` (m/s², the LIN/CIRC path acceleration; KSS
+  system variables as quoted by forum threads and simulation vendors' KUKA interface pages,
+  medium confidence) and ``Speed.angular_acceleration`` as ``$ACC.ORI1`` (deg/s², swivel;
+  ``$ACC.ORI2`` is left as the controller has it), with the path speed, only where the
+  program sets them (the controller's values apply otherwise).
 * ``$OUT[n] = TRUE``, ``WAIT SEC t``, ``WAIT FOR $IN[n]``, ``name(args)`` (the forms KUKA's inline
   forms produce). I/O numbers 1..4096 (:data:`IO_RANGE`; KR C4's digital inputs and outputs as
   recalled, unverified: a template folder may set the option ``io_range``).
@@ -105,6 +110,12 @@ NUMBERS: Mapping[str, NumberFormat] = {
     ),
     "vel_ori": NumberFormat(
         "orientation speed $VEL.ORI", "deg/s", 3, low=0.0, low_open=True, storage=_REAL
+    ),
+    "acc_cp": NumberFormat(
+        "path acceleration $ACC.CP", "m/s²", 4, low=0.0, low_open=True, storage=_REAL
+    ),
+    "acc_ori": NumberFormat(
+        "orientation acceleration $ACC.ORI1", "deg/s²", 3, low=0.0, low_open=True, storage=_REAL
     ),
     "percent": NumberFormat("axis speed or acceleration", "%", 0, 1, 100, storage="int"),
     "cdis": NumberFormat(
@@ -248,6 +259,9 @@ class KukaPost(Post):
     CALL_ARGUMENTS = ArgumentRule(
         one_of(NUMBER, double_quoted(), IDENTIFIER, "#" + IDENTIFIER, r"\$" + IDENTIFIER),
         'numbers, "strings", names, #ENUM values, $ variables',
+    )
+    ACCELERATIONS: ClassVar[frozenset[str]] = frozenset(
+        {"linear_acceleration", "angular_acceleration"}
     )
     NUMBERS: ClassVar[Mapping[str, NumberFormat]] = NUMBERS
     FILTERS: ClassVar[Mapping[str, Filter]] = FILTERS

@@ -20,8 +20,10 @@ Conventions shared with frontends (rotation vectors, the flange, no configuratio
   ``base_pose`` is the target in ``station base · controller_base`` (for UR arms the kinematic
   base *is* the controller's Base, DH frame 0, see :mod:`olp.kinematics.ur`; the target equals
   forward kinematics of the planned joints, which resolve solved for it), and olp's user frames
-  need no counterpart on the controller. ``v`` = ``Speed.linear`` (m/s), ``a`` = URScript's default
-  1.2 m/s² (the IR has no linear acceleration). ``mode=0`` ("Unconstrained mode. Interpolate
+  need no counterpart on the controller. ``v`` = ``Speed.linear`` (m/s), ``a`` =
+  ``Speed.linear_acceleration`` (m/s², "tool acceleration") where set, else URScript's default
+  1.2 m/s². The orientation acceleration has no URScript counterpart (the base post warns).
+  ``mode=0`` ("Unconstrained mode. Interpolate
   orientation from current pose to target pose") for :attr:`~olp.ir.ArcOrientation.INTERPOLATE`
   and ``mode=1`` ("Fixed mode. Keep orientation constant relative to the tangent of the circular
   arc") for :attr:`~olp.ir.ArcOrientation.PATH_CONSTANT`; the via pose's rotation is not used
@@ -140,9 +142,11 @@ def movej_acceleration(post: Post, speed: Any) -> str:
     return post.number("acceleration", speed.joint_acceleration * MOVEJ_ACCELERATION)
 
 
-def movel_acceleration(post: Post, _speed: Any = None) -> str:
-    """``a`` of ``movel``/``movec`` in m/s²: URScript's default."""
-    return post.number("acceleration", MOVEL_ACCELERATION)
+def movel_acceleration(post: Post, speed: Any = None) -> str:
+    """``a`` of ``movel``/``movec`` in m/s²: ``speed.linear_acceleration`` where the program sets
+    one (URScript manual, ``movel``: "a: tool acceleration [m/s^2]"), else URScript's default."""
+    accel = None if speed is None else speed.linear_acceleration
+    return post.number("acceleration", MOVEL_ACCELERATION if accel is None else accel)
 
 
 def linear_speed(post: Post, speed: Any) -> str:
@@ -221,6 +225,7 @@ class UrPost(Post):
     COMMENTS = CommentRule(collapse=True)
     IO_RANGE = (0, 9)
     CALL_ARGUMENTS = ArgumentRule(_LITERAL, 'numbers and "strings" without " or \\')
+    ACCELERATIONS: ClassVar[frozenset[str]] = frozenset({"linear_acceleration"})
     NUMBERS: ClassVar[Mapping[str, NumberFormat]] = NUMBERS
     FILTERS: ClassVar[Mapping[str, Filter]] = FILTERS
     TRANSFORMS = (cap_blend_radii,)

@@ -303,7 +303,14 @@ class ProgramView:
             last, "joint_speed", (ins.speed.joint, ins.speed.joint_acceleration)
         )
         new_linear_speed = not joint and changed(
-            last, "linear_speed", (ins.speed.linear, ins.speed.angular)
+            last,
+            "linear_speed",
+            (
+                ins.speed.linear,
+                ins.speed.angular,
+                ins.speed.linear_acceleration,
+                ins.speed.angular_acceleration,
+            ),
         )
         point, via = names.points[step.index]
         return PostStep(

@@ -51,7 +51,9 @@ class InlineForms(Core):
             "INITMOV": lambda s: self._ignore(
                 s, "BAS(#INITMOV) resets controller defaults; olp starts from its own"
             ),
-            "ACC_CP": lambda s: self._ignore(s, "path acceleration is not part of olp's IR"),
+            "ACC_CP": lambda s: self._ignore(
+                s, "BAS #ACC_CP is a percentage of the machine's path acceleration, unknown to olp"
+            ),
             "VEL_CP": lambda s: self._vel_cp(self._bas_number(s, "$VEL.CP (m/s)"), s.span),
             "VEL_PTP": lambda s: self._all_axes("$VEL_AXIS", self._bas_percent(s, "#VEL_PTP")),
             "ACC_PTP": lambda s: self._all_axes("$ACC_AXIS", self._bas_percent(s, "#ACC_PTP")),

@@ -158,8 +158,12 @@ SYSTEM_REASONS = {
     "$APO.CPTP": "$APO.CPTP (%) is not lowered: olp approximates C_PTP with $APO.CDIS",
     "$APO.CORI": "$APO.CORI is not lowered: olp approximates C_ORI with $APO.CDIS",
     "$APO.CVEL": "$APO.CVEL is not lowered: olp approximates C_VEL with $APO.CDIS",
-    "$ACC.CP": "path acceleration ($ACC.CP) is not part of olp's IR",
-    "$ACC": "path acceleration ($ACC) is not part of olp's IR",
+    # Reached only for forms no setter reads (a spline WITH's SACC_CP(...)): plain
+    # assignments of $ACC.CP / $ACC.ORI1 / $ACC are lowered.
+    "$ACC.CP": "a computed path acceleration ($ACC.CP from a function) is not lowered",
+    "$ACC": "a computed path acceleration ($ACC from a function) is not lowered",
+    "$ACC.ORI2": "$ACC.ORI2 (rotation about the tool axis) is not lowered: olp's orientation "
+    "acceleration is $ACC.ORI1's",
     "$ADVANCE": "the advance run does not change the path",
     "$CIRC_MODE": "$CIRC_MODE is not lowered: olp ignores the auxiliary point's orientation",
     "$LOAD": "payload data are not part of olp's IR",
@@ -268,6 +272,9 @@ class Core:
         self._reported: set[tuple[Any, ...]] = set()
         self._setters: dict[str, Callable[[str, Expr, Stmt], None]] = {
             "$VEL.CP": self._set_vel_cp,
+            "$ACC.CP": self._set_acc_cp,
+            "$ACC.ORI1": self._set_acc_ori1,
+            "$ACC": self._set_struct,
             "$APO.CDIS": self._set_apo_cdis,
             "$BASE": self._set_base,
             "$TOOL": self._set_tool,
@@ -369,6 +376,27 @@ class Core:
             raise self._error(f"$VEL.CP (m/s) must be > 0, found {speed:g}", span)
         new_speed = dataclasses.replace(self.state.speed, linear=speed)
         self.state = dataclasses.replace(self.state, speed=new_speed, vel_cp_set=True)
+
+    def _set_acc_cp(self, name: str, value: Expr, stmt: Stmt) -> None:
+        """``$ACC.CP`` (m/s²): the TCP path acceleration of LIN and CIRC motions (KUKA system
+        variables: "path acceleration", in m/s²; medium confidence on the unit from the KSS
+        documentation as cited in vendor notes and forum threads, e.g. a KSS default of 2.3)."""
+        accel = self._number(value, "$ACC.CP (m/s²)")
+        if accel <= 0:
+            raise self._error(f"$ACC.CP (m/s²) must be > 0, found {accel:g}", value.span)
+        self._set_speed(linear_acceleration=accel)
+
+    def _set_acc_ori1(self, name: str, value: Expr, stmt: Stmt) -> None:
+        """``$ACC.ORI1`` (deg/s²): the TCP's swivel (orientation) acceleration; olp's
+        orientation acceleration limit, in rad/s²."""
+        accel = self._number(value, "$ACC.ORI1 (deg/s²)")
+        if accel <= 0:
+            raise self._error(f"$ACC.ORI1 (deg/s²) must be > 0, found {accel:g}", value.span)
+        self._set_speed(angular_acceleration=math.radians(accel))
+
+    def _set_speed(self, **changes: float) -> None:
+        speed = dataclasses.replace(self.state.speed, **changes)
+        self.state = dataclasses.replace(self.state, speed=speed)
 
     def _set_apo_cdis(self, name: str, value: Expr, stmt: Stmt) -> None:
         self._cdis(self._number(value, "$APO.CDIS (mm)"), value.span, "$APO.CDIS (mm)")
