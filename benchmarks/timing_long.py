@@ -13,7 +13,10 @@ milling cell, timed as
 The reference (``TimingOptions(solver="toppra", straight_lines=False)``, the path olp took
 before) runs on the first ``--reference-moves`` moves, the default on all N and on that prefix.
 On the prefix the cycle times are compared with the reference and with the reachability solver
-on a grid 8x finer (the converged optimum). Run from the repository root::
+on a grid 8x finer (the converged optimum), all three acceleration-limited (the reference has
+no jerk-limited laws). On all N the default (jerk-limited path moves) is also compared with the
+acceleration-limited model (``path_jerk=False``, the model before jerk on path moves): its
+time and cycle time, and the ratios. Run from the repository root::
 
     python -m benchmarks.timing_long [--moves N] [--reference-moves R]
 
@@ -39,7 +42,7 @@ from olp.station.loader import load_station
 from olp.trajectory import LineTimeLaw
 
 REPO = Path(__file__).resolve().parents[1]
-REFERENCE = TimingOptions(solver="toppra", straight_lines=False)
+REFERENCE = TimingOptions(solver="toppra", straight_lines=False, path_jerk=False)
 """The toppra package on every path problem, no closed-form lines: the path olp took before."""
 CONVERGED = TimingOptions(
     grid_per_sample=16,
@@ -47,8 +50,11 @@ CONVERGED = TimingOptions(
     max_grid_turn_rad=math.radians(0.125),
     refine_points=96,
     straight_lines=False,
+    path_jerk=False,
 )
 """The reachability solver on a grid 8x finer than the default in every respect."""
+ACCEL_ONLY = TimingOptions(path_jerk=False)
+"""The default without jerk on path moves (the model the references compare with)."""
 
 
 def _zoned(program: ir.Program, zone: float) -> ir.Program:
@@ -94,10 +100,16 @@ def _case(name: str, program: ir.Program, reference_moves: int) -> None:
     print(f"{name}_rate: {moves / fast_s:.0f} moves/s")
     print(f"{name}_closed_form_moves: {lines / moves * 100:.1f} %")
     print(f"{name}_cycle_time: {fast.cycle_time:.3f} s")
+    accel_s, accel_only = _timed(compiled, ACCEL_ONLY)
+    print(f"{name}_acceleration_limited_time: {accel_s:.2f} s")
+    print(f"{name}_time_ratio_vs_acceleration_limited: {fast_s / accel_s:.2f} x")
+    print(f"{name}_acceleration_limited_cycle_time: {accel_only.cycle_time:.3f} s")
+    ratio = fast.cycle_time / accel_only.cycle_time
+    print(f"{name}_cycle_time_ratio_vs_acceleration_limited: {ratio:.4f} x")
 
     prefix = ir.Program(name="prefix", instructions=program.instructions[: reference_moves + 1])
     small = resolve(prefix, station)
-    small_s, small_fast = _timed(small, TimingOptions())
+    small_s, small_fast = _timed(small, ACCEL_ONLY)
     ref_s, ref = _timed(small, REFERENCE)
     converged = _timed(small, CONVERGED)[1]
     print(f"{name}_reference_rate: {reference_moves / ref_s:.0f} moves/s ({reference_moves} moves)")

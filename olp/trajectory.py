@@ -6,8 +6,10 @@ A segment is a time window of a *time law*:
 * :class:`JerkProfile` — a Ruckig joint move: per axis seven phases of constant jerk;
 * :class:`PathTimeLaw` — a TOPPRA path: a joint spline ``q(s)`` and a path speed that changes
   with constant path acceleration between gridpoints;
+* :class:`SmoothedTimeLaw` — a :class:`PathTimeLaw` averaged over a sliding window: the
+  jerk-limited law of a path chain;
 * :class:`LineTimeLaw` — a stop-to-stop path move along a straight joint-space line, timed in
-  closed form: a trapezoid (or triangle) in the fraction of the line.
+  closed form: a double S (jerk-limited; a trapezoid without jerk) in the fraction of the line.
 
 Several steps share one :class:`PathTimeLaw` when their moves are blended into one path. All
 laws evaluate vectorised in numpy and need neither Ruckig nor TOPPRA afterwards.
@@ -25,7 +27,7 @@ from __future__ import annotations
 
 import io
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol, overload
 
@@ -153,14 +155,142 @@ class PathTimeLaw:
 
 
 @dataclass(frozen=True, slots=True, eq=False)
+class SmoothedTimeLaw:
+    """A :class:`PathTimeLaw` ``base`` whose path parameter is averaged over a sliding window of
+    ``window`` s (a moving-average, "FIR", filter of the time law): ``s(t) = (1 / w)
+    ∫_{t-w}^{t} s_base(τ) dτ``, with the base at rest before 0 and after its end. Then
+    ``ds/dt = (s_base(t) - s_base(t - w)) / w``, ``d²s/dt² = (ṡ_base(t) - ṡ_base(t - w)) / w``
+    and ``d³s/dt³ = (s̈_base(t) - s̈_base(t - w)) / w``: the path speed and acceleration stay
+    within the base's ranges, the path jerk is bounded by the base's largest change of
+    acceleration within ``w`` over ``w``, and the move lasts ``w`` longer (Biagiotti &
+    Melchiorri, "FIR filters for online trajectory planning with time- and frequency-domain
+    specifications", Control Engineering Practice 20, 2012; see
+    :mod:`olp.passes.timing.jerk`). ``stretch`` >= 1 slows the averaged law uniformly (time
+    ``t`` of the law is ``t / stretch`` of the average: speeds divided by it, accelerations by
+    its square)."""
+
+    base: PathTimeLaw
+    window: float
+    stretch: float = 1.0
+    _integrals: FloatArray = field(init=False, repr=False)
+    _accels: FloatArray = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        law = self.base
+        # Absurdly slow laws (hours per micrometre) overflow to inf here, as their times do.
+        with np.errstate(over="ignore", invalid="ignore"):
+            h = np.diff(law.t)
+            accel = (law.sd[1:] ** 2 - law.sd[:-1] ** 2) / (2.0 * np.diff(law.s))
+            pieces = law.s[:-1] * h + law.sd[:-1] * h**2 / 2 + accel * h**3 / 6
+        object.__setattr__(self, "_accels", accel)
+        object.__setattr__(self, "_integrals", np.concatenate([[0.0], np.cumsum(pieces)]))
+
+    @property
+    def path(self) -> GeometricPath:
+        return self.base.path
+
+    @property
+    def duration(self) -> float:
+        return (self.base.duration + self.window) * self.stretch
+
+    def _integral(self, t: FloatArray) -> FloatArray:
+        """``∫_0^t s_base`` (T,) at times ``t`` (T,) s (``s_base = 0`` before 0)."""
+        law, total, accel = self.base, self._integrals, self._accels
+        with np.errstate(over="ignore", invalid="ignore"):
+            tt = np.clip(t, 0.0, law.t[-1])
+            i = np.clip(np.searchsorted(law.t, tt, side="right") - 1, 0, law.s.size - 2)
+            tau = tt - law.t[i]
+            inside = total[i] + law.s[i] * tau + law.sd[i] * tau**2 / 2 + accel[i] * tau**3 / 6
+            after = np.maximum(t - law.t[-1], 0.0) * law.s[-1]
+            out: FloatArray = np.where(t <= 0.0, 0.0, inside + after)
+        return out
+
+    def _base_state(self, t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        s, sd, sdd = self.base.path_state(t)
+        return s, sd, np.where(t < 0.0, 0.0, sdd)
+
+    def path_state(self, t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Path parameter, its speed and acceleration (T,) each at times ``t`` (T,) s."""
+        k = self.stretch
+        s, sd, sdd = self._averaged(np.asarray(t, dtype=np.float64) / k)
+        return s, sd / k, sdd / k**2
+
+    def _averaged(self, t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        w = self.window
+        tt = np.clip(t, 0.0, self.base.duration + w)
+        now, before = self._base_state(tt), self._base_state(tt - w)
+        s = (self._integral(tt) - self._integral(tt - w)) / w
+        s = np.clip(s, self.base.s[0], self.base.s[-1])
+        return s, (now[0] - before[0]) / w, (now[1] - before[1]) / w
+
+    def time_at(self, s: FloatArray) -> FloatArray:
+        """Times (N,) s at which the path parameter reaches ``s`` (N,): interpolated on the
+        times where the averaged law changes form, then refined by Newton steps."""
+        w, law = self.window, self.base
+        knots = self.knots()
+        along = self._averaged(knots)[0]
+        t = np.interp(s, along, knots)
+        # One Newton step: between knots the averaged law is one cubic, close to the chord.
+        here, speed, _accel = self._averaged(t)
+        step = np.where(speed > 0.0, (here - s) / np.where(speed > 0.0, speed, 1.0), 0.0)
+        t = np.clip(t - step, 0.0, law.duration + w)
+        t = np.where(s <= law.s[0], 0.0, t)
+        out: FloatArray = np.where(s >= law.s[-1], law.duration + w, t) * self.stretch
+        return out
+
+    def knots(self) -> FloatArray:
+        """Times (of the unstretched average) where it changes form: the base's gridpoint
+        times and those shifted by the window."""
+        return np.unique(np.concatenate([self.base.t, self.base.t + self.window]))
+
+    def state(self, t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Joint position, velocity, acceleration (T, dof) at times ``t`` (T,) s."""
+        s, sd, sdd = self.path_state(t)
+        dq, ddq = self.path(s, 1), self.path(s, 2)
+        return self.path(s), dq * sd[:, None], ddq * (sd**2)[:, None] + dq * sdd[:, None]
+
+
+def _ramp_state(
+    t: FloatArray, jerk_time: Any, ramp: Any, accel: Any
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Distance, speed and acceleration (T,) at times ``t`` (T,) in ``[0, ramp]`` of a ramp from
+    rest (the first phase of a double S, :mod:`olp.passes.timing.scurve`): jerk over
+    ``jerk_time`` up to ``accel``, held, jerk down to 0 at ``ramp`` (scalars or (T,))."""
+    tj, ta, ap = jerk_time, ramp, accel
+    peak = ap * (ta - tj)
+    safe = np.where(tj > 0, tj, 1.0)
+    rising, falling = t < tj, t > ta - tj
+    rest = ta - t
+    mid = t - tj
+    u = np.where(
+        rising,
+        ap * t**3 / (6 * safe),
+        np.where(
+            falling,
+            peak * ta / 2 - peak * rest + ap * rest**3 / (6 * safe),
+            ap * tj**2 / 6 + ap * tj / 2 * mid + ap * mid**2 / 2,
+        ),
+    )
+    v = np.where(
+        rising,
+        ap * t**2 / (2 * safe),
+        np.where(falling, peak - ap * rest**2 / (2 * safe), ap * tj / 2 + ap * mid),
+    )
+    a = np.where(rising, ap * t / safe, np.where(falling, ap * rest / safe, ap))
+    return u, v, a
+
+
+@dataclass(frozen=True, slots=True, eq=False)
 class LineTimeLaw:
-    """Rest to rest along the straight joint line ``q0 + u (q1 - q0)``, ``u`` from 0 to 1: ``u``
-    accelerates at ``accel``, cruises, and brakes at ``accel`` (a triangle when ``ramp`` is half
-    the duration).
+    """Rest to rest along the straight joint line ``q0 + u (q1 - q0)``, ``u`` from 0 to 1: a
+    double S (:mod:`olp.passes.timing.scurve`) in ``u``: each ramp raises the acceleration to
+    ``accel`` at constant jerk over ``jerk_time``, holds it, lowers it over ``jerk_time``; the
+    move cruises between the ramps (none when ``ramp`` is half the duration). ``jerk_time`` 0 is
+    a trapezoid.
 
     ``q0``, ``q1``: the line's ends (dof,) rad; ``accel``: 1/s² in fractions of the line;
     ``ramp``: the time (s) of each of the acceleration and braking phases; ``total``: the
-    duration (s). The cruise speed is ``accel * ramp`` (1/s).
+    duration (s); ``jerk_time`` (s). The cruise speed is ``accel * (ramp - jerk_time)`` (1/s).
     """
 
     q0: FloatArray
@@ -168,6 +298,7 @@ class LineTimeLaw:
     accel: float
     ramp: float
     total: float
+    jerk_time: float = 0.0
 
     @property
     def duration(self) -> float:
@@ -178,13 +309,16 @@ class LineTimeLaw:
         ``t`` (T,) s; held at the ends outside ``[0, duration]``."""
         tt = np.clip(t, 0.0, self.total)
         rest = self.total - tt
-        a, ramp = self.accel, self.ramp
+        tj, ramp, a = self.jerk_time, self.ramp, self.accel
+        peak = a * (ramp - tj)
         rising, falling = tt < ramp, rest < ramp
-        u = np.where(rising, 0.5 * a * tt**2, a * ramp * (tt - 0.5 * ramp))
-        u = np.where(falling, 1.0 - 0.5 * a * rest**2, u)
-        ud = a * np.where(rising, tt, np.where(falling, rest, ramp))
+        up = _ramp_state(np.minimum(tt, ramp), tj, ramp, a)
+        down = _ramp_state(np.minimum(rest, ramp), tj, ramp, a)
+        u = np.where(rising, up[0], peak * ramp / 2 + peak * (tt - ramp))
+        u = np.where(falling, 1.0 - down[0], u)
+        ud = np.where(rising, up[1], np.where(falling, down[1], peak))
         # At a triangle's peak both phases meet; the end holds still (as PathTimeLaw).
-        udd = np.where(rising, a, np.where(falling & (rest > 0.0), -a, 0.0))
+        udd = np.where(rising, up[2], np.where(falling & (rest > 0.0), -down[2], 0.0))
         return u, ud, udd
 
     def state(self, t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -196,13 +330,20 @@ class LineTimeLaw:
 
 class LineLaws(Sequence[LineTimeLaw]):
     """Many :class:`LineTimeLaw` as arrays (a toolpath's fine-stopped moves), each law made
-    only when asked for: ``q0``, ``q1`` (M, dof) rad; ``accel`` (M,) 1/s², ``ramp`` and
-    ``total`` (M,) s, as the fields of :class:`LineTimeLaw`."""
+    only when asked for: ``q0``, ``q1`` (M, dof) rad; ``accel`` (M,) 1/s², ``ramp``, ``total``
+    and ``jerk_time`` (M,) s, as the fields of :class:`LineTimeLaw`."""
 
     def __init__(
-        self, q0: FloatArray, q1: FloatArray, accel: FloatArray, ramp: FloatArray, total: FloatArray
+        self,
+        q0: FloatArray,
+        q1: FloatArray,
+        accel: FloatArray,
+        ramp: FloatArray,
+        total: FloatArray,
+        jerk_time: FloatArray | None = None,
     ) -> None:
         self.q0, self.q1, self.accel, self.ramp, self.total = q0, q1, accel, ramp, total
+        self.jerk_time = np.zeros_like(total) if jerk_time is None else jerk_time
 
     def __len__(self) -> int:
         return int(self.total.size)
@@ -217,7 +358,12 @@ class LineLaws(Sequence[LineTimeLaw]):
         if isinstance(k, slice):
             return [self[i] for i in range(*k.indices(len(self)))]
         return LineTimeLaw(
-            self.q0[k], self.q1[k], float(self.accel[k]), float(self.ramp[k]), float(self.total[k])
+            self.q0[k],
+            self.q1[k],
+            float(self.accel[k]),
+            float(self.ramp[k]),
+            float(self.total[k]),
+            float(self.jerk_time[k]),
         )
 
 

@@ -15,6 +15,10 @@
 Documented tolerances (see :mod:`olp.passes.timing`): joint velocities and TCP speed 0.1%,
 joint accelerations 0.5%, closed forms 0.5%, a finer grid 1%, the reachability solver against
 toppra 1e-5, closed-form lines against TOPPRA on a finer grid 0.1%.
+
+Everything here is the acceleration-limited model (``TimingOptions(path_jerk=False)``: the
+module's ``time_program`` sets it); the jerk-limited laws of path moves are tested in
+tests/passes/test_jerk.py.
 """
 
 from __future__ import annotations
@@ -50,13 +54,27 @@ from olp.passes.timing import (
     speed_sweep,
     straight_paths,
     tcp_rates,
-    time_program,
+)
+from olp.passes.timing import (
+    time_program as _time_program,
 )
 from olp.station.loader import load_station
 from olp.station.model import JointLimits, Station
 from olp.trajectory import LineTimeLaw, PathTimeLaw
 
 REPO = Path(__file__).resolve().parents[2]
+
+
+def time_program(
+    compiled: CompiledProgram,
+    other_times: dict[str, float] | None = None,
+    options: TimingOptions | None = None,
+) -> CompiledProgram:
+    """:func:`olp.passes.timing.time_program` with path moves acceleration-limited only."""
+    accel_only = dataclasses.replace(options or TimingOptions(), path_jerk=False)
+    return _time_program(compiled, other_times, accel_only)
+
+
 Q0 = np.radians([10, -80, 95, 0, 30, 0])
 FINE_GRID = TimingOptions(
     grid_per_sample=16,
@@ -523,12 +541,13 @@ def test_speed_sweep_matches_retiming_and_is_monotonic(station: Station, tool: i
     ]
     compiled = _compiled(station, tool, *moves)
     linear, joint = [0.05, 0.1, 0.4], [0.25, 0.5, 1.0]
-    table = speed_sweep(compiled, linear, joint)
+    accel_only = TimingOptions(path_jerk=False)
+    table = speed_sweep(compiled, linear, joint, options=accel_only)
     assert table.shape == (3, 3)
     assert np.all(np.diff(table, axis=0) < 0) and np.all(np.diff(table, axis=1) < 0)
     direct = time_program(override_speeds(compiled, linear=0.4, joint=0.25))
     assert table[2, 0] == pytest.approx(direct.cycle_time, rel=1e-9)
-    programmed = speed_sweep(compiled, [None], [None])
+    programmed = speed_sweep(compiled, [None], [None], options=accel_only)
     assert programmed[0, 0] == pytest.approx(compiled.cycle_time, rel=1e-9)
 
 

@@ -26,16 +26,24 @@ def path_problem(
     linear_speed: FloatArray,
     angular_speed: FloatArray,
     options: TimingOptions | None = None,
+    linear_accel: FloatArray | None = None,
+    angular_accel: FloatArray | None = None,
 ) -> PathProblem:
     """The problem of timing a chain with ``linear_speed`` (M,) m/s and ``angular_speed`` (M,)
-    rad/s (``inf``: none) per instruction: the limit of an instruction holds up to its
-    boundaries, the smaller of two at a boundary."""
+    rad/s (``inf``: none) per instruction, and optionally TCP path and orientation
+    accelerations ``linear_accel`` (M,) m/s² and ``angular_accel`` (M,) rad/s²: the limit of
+    an instruction holds up to its boundaries, the smaller of two at a boundary."""
     grid = gridpoints(geometry, options or TimingOptions())
     linear = _piecewise(geometry.boundaries, linear_speed)(grid)
-    angular = np.full(grid.size, np.inf)
-    if np.any(np.isfinite(angular_speed)):
-        angular = _piecewise(geometry.boundaries, angular_speed)(grid)
-    return PathProblem(joint_path(geometry), grid, tool, linear, angular)
+    angular, lin_acc, ang_acc = (
+        _piecewise(geometry.boundaries, values)(grid)
+        if values is not None and np.any(np.isfinite(values))
+        else None
+        for values in (angular_speed, linear_accel, angular_accel)
+    )
+    if angular is None:
+        angular = np.full(grid.size, np.inf)
+    return PathProblem(joint_path(geometry), grid, tool, linear, angular, lin_acc, ang_acc)
 
 
 def time_path(

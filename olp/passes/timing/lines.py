@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from olp.geometry import rotation_log
+from olp.passes.timing.scurve import double_s
 from olp.passes.timing.tcp import tcp_poses
 from olp.station.model import Robot
 
@@ -31,16 +32,18 @@ one axis to another): the model-joint direction has at most twice the 1-norm."""
 class LineProfiles:
     """Closed-form rest-to-rest time laws along straight joint lines, one per move (M,).
 
-    ``accel``: acceleration in fractions of the line, 1/s²; ``ramp``: the time (s) of each of
-    the acceleration and braking phases; ``duration`` (s); ``excess``: a bound on the relative
-    excess of ``duration`` over the time-optimal duration of the move (0 where no TCP limit
-    binds: the trapezoid is then exact).
+    ``accel``: the acceleration held between the jerk phases, in fractions of the line, 1/s²;
+    ``ramp``: the time (s) of each of the acceleration and braking phases; ``jerk_time`` (s):
+    of each jerk phase (0 without a jerk limit: a trapezoid); ``duration`` (s); ``excess``: a
+    bound on the relative excess of ``duration`` over the time-optimal duration of the move (0
+    where no TCP limit binds: the profile is then exact).
     """
 
     accel: FloatArray
     ramp: FloatArray
     duration: FloatArray
     excess: FloatArray
+    jerk_time: FloatArray
 
 
 def line_profiles(
@@ -50,11 +53,25 @@ def line_profiles(
     tools: FloatArray,
     linear_speed: FloatArray,
     angular_speed: FloatArray,
+    linear_accel: FloatArray | None = None,
+    angular_accel: FloatArray | None = None,
+    jerk: bool = True,
 ) -> LineProfiles:
     """Time-optimal rest-to-rest laws along the straight joint lines ``q0 -> q1`` (M, dof) rad,
-    vectorised over the moves, under the joint velocity and acceleration limits and a TCP
-    speed of at most ``linear_speed`` (M,) m/s and ``angular_speed`` (M,) rad/s (``inf``: none)
-    for the tools ``tools`` (M, 4, 4) (TCP in flange).
+    vectorised over the moves, under the joint velocity, acceleration and (``jerk``) jerk
+    limits, a TCP speed of at most ``linear_speed`` (M,) m/s and ``angular_speed`` (M,) rad/s
+    and a TCP path (tangential) acceleration of at most ``linear_accel`` (M,) m/s² and
+    orientation acceleration ``angular_accel`` (M,) rad/s² (``inf`` or None: none) for the
+    tools ``tools`` (M, 4, 4) (TCP in flange).
+
+    Jerk: joint j's jerk is ``e_j d³s/dt³``, so the joint jerk limits are exactly
+    ``|d³s/dt³| <= min_j J_j / |e_j|`` and the law is a double S in ``s``
+    (:func:`~olp.passes.timing.scurve.double_s`), whose duration is monotone in the speed and
+    acceleration caps: the bracketing below holds for it as for the trapezoid. TCP path
+    accelerations: the TCP's speed along its path is ``r ds/dt``, its rate of change
+    ``r d²s/dt² + r' (ds/dt)²`` with ``|r'| <= |p''|`` bounded like ``r`` (below); the
+    acceleration cap in ``s`` lies between ``(a - |r'| V²) / r_hi`` and ``(a + |r'| V²) / r_lo``
+    (likewise for the orientation with ``|w'| <= (c |e|_1)²``).
 
     Along ``q(s) = q0 + s e`` (``e`` the unit direction, ``s`` in [0, D] rad of joint chord)
     joint j moves at ``e_j ds/dt`` and accelerates at ``e_j d²s/dt²``: the joint limits are
@@ -83,18 +100,53 @@ def line_profiles(
     line = q1 - q0
     length = np.linalg.norm(line, axis=-1)
     unit = line / length[:, None]
+    none = np.full(length.shape, np.inf)
+    lin_acc = none if linear_accel is None else linear_accel
+    ang_acc = none if angular_accel is None else angular_accel
     with np.errstate(divide="ignore"):
         joint_cap = np.min(robot.limits.velocity / np.abs(unit), axis=-1)
         accel = np.min(robot.limits.acceleration / np.abs(unit), axis=-1)
-    rate_lo, rate_hi, turn_lo, turn_hi = _line_rates(q0, q1, robot, tools, angular_speed)
+        jerks = np.min(robot.limits.jerk / np.abs(unit), axis=-1) if jerk else none
+    turns = np.isfinite(angular_speed) | np.isfinite(ang_acc)
+    rates = _line_rates(q0, q1, robot, tools, np.where(turns, 1.0, np.inf))
+    rate_lo, rate_hi, turn_lo, turn_hi, bend, spin = rates
     with np.errstate(divide="ignore", invalid="ignore"):
         slow = np.minimum.reduce([joint_cap, linear_speed / rate_hi, angular_speed / turn_hi])
         fast = np.minimum.reduce([joint_cap, linear_speed / rate_lo, angular_speed / turn_lo])
-    ramp, duration = trapezoid(length, slow, accel)
-    best = trapezoid(length, fast, accel)[1]
+        slow_acc = np.minimum.reduce(
+            [
+                accel,
+                _accel_cap(lin_acc, -bend * slow**2, rate_hi),
+                _accel_cap(ang_acc, -spin * slow**2, turn_hi),
+            ]
+        )
+        fast_acc = np.minimum.reduce(
+            [
+                accel,
+                _accel_cap(lin_acc, bend * fast**2, rate_lo),
+                _accel_cap(ang_acc, spin * fast**2, turn_lo),
+            ]
+        )
+    law = double_s(length, slow, slow_acc, jerks)
+    best = double_s(length, fast, fast_acc, jerks).duration
+    with np.errstate(invalid="ignore"):
+        excess = np.where(slow_acc > 0, law.duration / best - 1.0, np.inf)
     return LineProfiles(
-        accel=accel / length, ramp=ramp, duration=duration, excess=duration / best - 1.0
+        accel=law.accel / length,
+        ramp=law.ramp,
+        duration=law.duration,
+        excess=excess,
+        jerk_time=law.jerk_time,
     )
+
+
+def _accel_cap(limit: FloatArray, slack: FloatArray, rate: FloatArray) -> FloatArray:
+    """The cap on ``d²s/dt²`` from a TCP acceleration ``limit`` (M,) (``inf``: none) at a rate
+    ``rate`` per unit of ``s``, the curvature term given as ``slack`` (M,) (negative: what the
+    slowest law must leave for it)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cap = np.where(np.isfinite(limit), (limit + slack) / rate, np.inf)
+    return np.where(np.isnan(cap), np.inf, cap)
 
 
 def trapezoid(length: FloatArray, peak: FloatArray, accel: FloatArray) -> tuple[FloatArray, ...]:
@@ -107,9 +159,11 @@ def trapezoid(length: FloatArray, peak: FloatArray, accel: FloatArray) -> tuple[
 
 def _line_rates(
     q0: FloatArray, q1: FloatArray, robot: Robot, tools: FloatArray, angular_speed: FloatArray
-) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
     """Bounds (M,) on the TCP's linear rate (m/rad) and orientation rate (rad/rad) along the
-    joint lines ``q0 -> q1``: low and high of each (see :func:`line_profiles`)."""
+    joint lines ``q0 -> q1``: low and high of each, and upper bounds on the magnitude of their
+    derivatives along the line, ``|p''|`` (m/rad²) and ``(c |e|_1)²`` (rad/rad²) (see
+    :func:`line_profiles`)."""
     line = q1 - q0
     length = np.linalg.norm(line, axis=-1)
     half = 0.5 * length
@@ -135,7 +189,19 @@ def _line_rates(
         relative = np.swapaxes(rotations[0][limited], -1, -2) @ rotations[4][limited]
         turn[limited] = np.linalg.norm(rotation_log(relative), axis=-1) / length[limited]
     spread = half * norm1**2 * (1.0 + half * norm1)
-    return np.maximum(rate_lo, 0.0), rate_hi, np.maximum(turn - spread, 0.0), turn + spread
+    bend_hi = (
+        np.linalg.norm(bend, axis=-1)
+        + half * np.linalg.norm(twist, axis=-1)
+        + half**2 * norm1**4 * _REACH_BOUND_M
+    )
+    return (
+        np.maximum(rate_lo, 0.0),
+        rate_hi,
+        np.maximum(turn - spread, 0.0),
+        turn + spread,
+        bend_hi,
+        norm1**2,
+    )
 
 
 def _remainder(half: FloatArray, norm1: FloatArray) -> FloatArray:

@@ -56,7 +56,9 @@ class TimingOptions:
     straight joint-space line in closed form (:func:`line_profiles`) where its error bound is
     below ``line_tolerance`` (relative excess over the time-optimal duration);
     ``line_deviation_rad``: how far a move's samples may lie off the chord of its joint path
-    and still count as one straight line.
+    and still count as one straight line. ``path_jerk``: path moves respect the joint jerk
+    limits too (a double S on straight lines, a jerk-limited law along chains: see
+    :mod:`olp.passes.timing.jerk`); False gives the acceleration-limited optimum.
     """
 
     grid_per_sample: int = 2
@@ -71,6 +73,7 @@ class TimingOptions:
     # 1e-7 rad moves a TCP 1 m from the axes by 0.1 um: far below the resolve pass's own
     # sampling error, so the chord and the samples are the same path.
     line_deviation_rad: float = 1e-7
+    path_jerk: bool = True
 
 
 class TimingError(Exception):

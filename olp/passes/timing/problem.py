@@ -20,13 +20,29 @@ FloatArray = NDArray[np.float64]
 class PathProblem:
     """One chain to time, rest to rest: its joint path, gridpoints ``grid`` (K,) and, at them,
     the TCP's linear (m/s) and orientation (rad/s, ``inf``: none) speed limits (K,) each, for
-    the tool ``tool`` (4, 4) (TCP in flange). Joint limits are the robot's."""
+    the tool ``tool`` (4, 4) (TCP in flange); optionally the TCP's path (tangential)
+    acceleration (m/s²) and orientation acceleration (rad/s²) limits (K,) each (``inf`` or
+    None: none). Joint limits are the robot's; every acceleration limit (joint and TCP) is
+    scaled by ``accel_scale``, and the path speed ``ds/dt`` is at most ``speed_cap`` (the
+    jerk-limited law's second solve, :mod:`olp.passes.timing.jerk`)."""
 
     path: JointSpline
     grid: FloatArray
     tool: FloatArray
     linear: FloatArray
     angular: FloatArray
+    linear_acceleration: FloatArray | None = None
+    angular_acceleration: FloatArray | None = None
+    accel_scale: float = 1.0
+    speed_cap: float = float(np.inf)
+
+    @property
+    def tcp_accelerations(self) -> bool:
+        """Whether a TCP acceleration limit is set anywhere on the chain."""
+        return any(
+            limit is not None and bool(np.any(np.isfinite(limit)))
+            for limit in (self.linear_acceleration, self.angular_acceleration)
+        )
 
 
 def speed_bounds(

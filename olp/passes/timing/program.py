@@ -23,7 +23,7 @@ from olp.compiled import CompiledProgram, PathBlock, RowTrajectories, Step, item
 from olp.compiled import span_of as _span
 from olp.diagnostics import Diagnostic
 from olp.ir import is_motion
-from olp.passes.timing import ptp
+from olp.passes.timing import jerk, ptp
 from olp.passes.timing.chains import PATH_SOLVERS, path_problem, time_law
 from olp.passes.timing.geometry import joined_geometry
 from olp.passes.timing.lines import line_profiles, straight_samples
@@ -34,6 +34,7 @@ from olp.passes.timing.plan import (
     fixed_time,
     time_table,
 )
+from olp.passes.timing.problem import PathProblem
 from olp.passes.timing.table import (
     COMMENT,
     FIXED,
@@ -46,7 +47,8 @@ from olp.passes.timing.table import (
     plan,
     travel,
 )
-from olp.trajectory import LineLaws, Segment, TimeLaw
+from olp.station.model import Robot
+from olp.trajectory import LineLaws, PathTimeLaw, Segment, SmoothedTimeLaw, TimeLaw
 
 if TYPE_CHECKING:
     from olp.passes.pipeline import BuildOptions
@@ -198,11 +200,26 @@ def time_lines(
     q0, q1 = table.q[table.lo[rows]], table.q[table.hi[rows]]
     robot = table.compiled.station.robot
     tools = table.tools[table.tool[rows]]
-    profiles = line_profiles(q0, q1, robot, tools, table.linear[rows], table.angular[rows])
+    profiles = line_profiles(
+        q0,
+        q1,
+        robot,
+        tools,
+        table.linear[rows],
+        table.angular[rows],
+        table.linear_acceleration[rows],
+        table.angular_acceleration[rows],
+        jerk=options.path_jerk,
+    )
     ok = profiles.excess <= options.line_tolerance
     rows = rows[ok]
     out.lines = LineLaws(
-        q0[ok], q1[ok], profiles.accel[ok], profiles.ramp[ok], profiles.duration[ok]
+        q0[ok],
+        q1[ok],
+        profiles.accel[ok],
+        profiles.ramp[ok],
+        profiles.duration[ok],
+        profiles.jerk_time[ok],
     )
     out.duration[rows] = out.end[rows] = profiles.duration[ok]
     out.start[rows] = 0.0
@@ -238,19 +255,68 @@ def time_chains(
             out.duration[rows] = out.length[rows] = 0.0
             out.timed[rows] = True
             continue
-        problem = path_problem(geometry, tool, table.linear[rows], table.angular[rows], options)
+        problem = path_problem(
+            geometry,
+            tool,
+            table.linear[rows],
+            table.angular[rows],
+            options,
+            table.linear_acceleration[rows],
+            table.angular_acceleration[rows],
+        )
         posed.append((rows, geometry, problem))
-    speeds = PATH_SOLVERS[options.solver]([problem for _, _, problem in posed], robot)
-    for (rows, geometry, problem), sd in zip(posed, speeds, strict=True):
-        try:
-            law = time_law(problem, sd)
-        except TimingError as exc:
+    laws = solve_laws([problem for _, _, problem in posed], robot, options)
+    for (rows, geometry, _), law in zip(posed, laws, strict=True):
+        if isinstance(law, TimingError):
             first = int(rows[0])
-            found.append(Diagnostic("error", "timing", str(exc), _span(steps, first), first))
+            found.append(Diagnostic("error", "timing", str(law), _span(steps, first), first))
             continue
         _fill(out, rows, out.add_law(law), law.time_at(geometry.boundaries))
         out.length[rows] = geometry.lengths
     return found
+
+
+def solve_laws(
+    problems: Sequence[PathProblem], robot: Robot, options: TimingOptions
+) -> list[PathTimeLaw | SmoothedTimeLaw | TimingError]:
+    """The time laws of ``problems`` by ``options.solver``, all at once; with
+    ``options.path_jerk`` jerk-limited (:mod:`~olp.passes.timing.jerk`: the chains whose
+    acceleration must drop for the jerk limit solved once more, together)."""
+    solver = PATH_SOLVERS[options.solver]
+    laws = _laws(problems, solver(problems, robot))
+    if not options.path_jerk:
+        return list(laws)
+    jerks = [jerk.path_jerk(p, robot) for p in problems]
+    scales = [
+        (np.inf, 1.0) if isinstance(law, TimingError) else jerk.scales(law, j)
+        for law, j in zip(laws, jerks, strict=True)
+    ]
+    again = [
+        k
+        for k, (cap, f) in enumerate(scales)
+        if np.isfinite(cap) or f < 1.0 - jerk.MIN_SCALE_CHANGE
+    ]
+    if again:
+        scaled = jerk.rescaled([problems[k] for k in again], [scales[k] for k in again])
+        for k, law in zip(again, _laws(scaled, solver(scaled, robot)), strict=True):
+            if not isinstance(law, TimingError):
+                laws[k] = law
+    return [
+        law if isinstance(law, TimingError) else jerk.jerk_limited(law, j, robot)
+        for law, j in zip(laws, jerks, strict=True)
+    ]
+
+
+def _laws(
+    problems: Sequence[PathProblem], speeds: Sequence[FloatArray]
+) -> list[PathTimeLaw | TimingError]:
+    out: list[PathTimeLaw | TimingError] = []
+    for problem, sd in zip(problems, speeds, strict=True):
+        try:
+            out.append(time_law(problem, sd))
+        except TimingError as exc:
+            out.append(exc)
+    return out
 
 
 def _fill(out: Times, rows: IntArray, law: int, edges: FloatArray) -> None:

@@ -11,6 +11,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from olp.passes.timing.problem import PathProblem, speed_bounds
+from olp.passes.timing.tcp import tcp_rates
 from olp.station.model import Robot
 
 FloatArray = NDArray[np.float64]
@@ -51,10 +52,59 @@ def _solve_batch(problems: Sequence[PathProblem], robot: Robot) -> list[FloatArr
     q, dq, ddq = (np.concatenate([p.path(p.grid, k) for p in problems]) for k in range(3))
     linear = np.concatenate([p.linear for p in problems])
     angular = np.concatenate([p.angular for p in problems])
-    bound = speed_bounds(robot, q, dq, _row_tools(problems, sizes), linear, angular)
+    tools = _row_tools(problems, sizes)
+    bound = speed_bounds(robot, q, dq, tools, linear, angular)
     bound[first], bound[first + sizes - 1] = 0.0, 0.0  # every chain starts and ends at rest
-    sd = _reachability(delta, dq, ddq, bound, robot.limits.acceleration)
+    caps = np.array([p.speed_cap for p in problems])
+    if np.any(np.isfinite(caps)):
+        bound = np.minimum(bound, np.repeat(caps**2, sizes))
+    accel: FloatArray = np.broadcast_to(robot.limits.acceleration, dq.shape)
+    scales = np.array([p.accel_scale for p in problems])
+    if np.any(scales != 1.0):
+        accel = accel * np.repeat(scales, sizes)[:, None]
+    if any(p.tcp_accelerations for p in problems):
+        s = np.concatenate([[0.0], np.cumsum(delta)])
+        dq, ddq, accel = _tcp_rows(problems, sizes, robot, tools, q, s, (dq, ddq, accel))
+    sd = _reachability(delta, dq, ddq, bound, accel)
     return np.split(sd, first[1:])
+
+
+def _tcp_rows(
+    problems: Sequence[PathProblem],
+    sizes: NDArray[np.int64],
+    robot: Robot,
+    tools: FloatArray,
+    q: FloatArray,
+    s: FloatArray,
+    rows: tuple[FloatArray, FloatArray, FloatArray],
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """The joint rows ``dq``, ``ddq``, ``accel`` (K, m) with the TCP accelerations as more
+    columns of the same form: the TCP's speed along its path is ``r(s) ds/dt`` (``r`` its linear
+    rate, :func:`tcp_rates`), so its tangential acceleration ``r u + r' x`` is a row with
+    ``q' = r``, ``q'' = r'`` and the limit ``a`` (the orientation likewise with the angular
+    rate). ``r'`` is the derivative along the joined gridpoints ``s`` (K,) by central
+    differences (at a chain's ends ``x = 0``, so the term vanishes there)."""
+    dq, ddq, accel = rows
+    scale = np.repeat(np.array([p.accel_scale for p in problems]), sizes)
+    linear_rate, angular_rate = tcp_rates(robot, tools, q, dq, angular=True)
+    for rate, name in (
+        (linear_rate, "linear_acceleration"),
+        (angular_rate, "angular_acceleration"),
+    ):
+        limits = [getattr(p, name) for p in problems]
+        if all(limit is None for limit in limits):
+            continue
+        limit = np.concatenate(
+            [
+                np.full(p.grid.size, np.inf) if v is None else v
+                for p, v in zip(problems, limits, strict=True)
+            ]
+        )
+        slope = np.gradient(rate, s) if rate.size > 1 else np.zeros_like(rate)
+        dq = np.concatenate([dq, rate[:, None]], axis=1)
+        ddq = np.concatenate([ddq, slope[:, None]], axis=1)
+        accel = np.concatenate([accel, (limit * scale)[:, None]], axis=1)
+    return dq, ddq, accel
 
 
 def _row_tools(problems: Sequence[PathProblem], sizes: NDArray[np.int64]) -> FloatArray:
@@ -72,11 +122,12 @@ def reachability_speeds(
     TOPPRA's reachability analysis with its discretisation, vectorised over the stages.
 
     ``dq``, ``ddq`` (K, dof): ``q'(s)`` and ``q''(s)`` at the gridpoints; ``x_max`` (K,): upper
-    bound on ``x = (ds/dt)²`` (:func:`speed_bounds`); ``accel`` (dof,) rad/s²: joint
-    acceleration limits, ``|q' u + q'' x| <= a`` with ``u = d²s/dt²``, imposed as TOPPRA's
-    *interpolation* scheme does: on each stage ``i`` (``x_i`` to ``x_{i+1} = x_i + 2 Δ_i u_i``)
-    at both of its gridpoints. In ``(x, y) = (x_i, x_{i+1})`` each of these 2·dof constraints
-    reads ``-c - w x <= y <= c - w x`` (:func:`_stage_rows`), so
+    bound on ``x = (ds/dt)²`` (:func:`speed_bounds`); ``accel`` (dof,) rad/s², or (K, dof) per
+    gridpoint: joint acceleration limits, ``|q' u + q'' x| <= a`` with ``u = d²s/dt²``, imposed
+    as TOPPRA's *interpolation* scheme does: on each stage ``i`` (``x_i`` to
+    ``x_{i+1} = x_i + 2 Δ_i u_i``) at both of its gridpoints. In ``(x, y) = (x_i, x_{i+1})``
+    each of these 2·dof constraints reads ``-c - w x <= y <= c - w x`` (:func:`_stage_rows`),
+    so
 
     * the largest controllable ``x_i`` (backward) is ``K_i = min(x_max_i, F_i,
       min_{w<0} (K_{i+1} + c) / -w)``, where ``F_i`` is the largest ``x`` for which the rows
@@ -97,7 +148,7 @@ def _reachability(
     """:func:`reachability_speeds` given the stage lengths ``delta`` (K - 1,)."""
     if not (np.all(np.isfinite(dq)) and np.all(np.isfinite(ddq)) and not np.any(np.isnan(x_max))):
         return np.full(delta.size + 1, np.nan)
-    rows = _StageRows(delta, dq, ddq, np.concatenate([accel, accel]))
+    rows = _StageRows(delta, dq, ddq, np.broadcast_to(accel, dq.shape))
     cap = np.minimum(x_max[:-1], _stage_caps(rows))
     controllable = _backward(rows, np.append(cap, 0.0))
     return np.sqrt(_forward(rows, controllable))
@@ -106,8 +157,8 @@ def _reachability(
 @dataclass(frozen=True, slots=True, eq=False)
 class _StageRows:
     """The stage constraints of :func:`reachability_speeds`, made on demand for any stages:
-    ``delta`` (N,) the stages' lengths; ``dq``, ``ddq`` (N+1, dof); ``accel`` (2 dof,) the
-    joint limits twice (at both ends of a stage)."""
+    ``delta`` (N,) the stages' lengths; ``dq``, ``ddq`` (N+1, m); ``accel`` (N+1, m) the
+    limits at each gridpoint (``inf``: none), of the joints and of any TCP rows."""
 
     delta: FloatArray
     dq: FloatArray
@@ -127,7 +178,8 @@ class _StageRows:
         alpha = np.concatenate([self.dq[i], self.dq[j] + twice * self.ddq[j]], axis=1)
         beta = np.concatenate([twice * self.ddq[i] - self.dq[i], -self.dq[j]], axis=1)
         size = np.maximum(np.abs(alpha), _TINY_RATE)
-        return twice * self.accel / size, np.where(alpha < 0, -beta, beta) / size
+        limit = np.concatenate([self.accel[i], self.accel[j]], axis=1)
+        return twice * limit / size, np.where(alpha < 0, -beta, beta) / size
 
 
 Stages = slice | NDArray[np.int64]

@@ -39,9 +39,10 @@ class MotionTable:
 
     ``kind`` (n,); ``lo``/``hi`` (n,): a motion's first and last row of ``q`` (S, dof) rad (-1
     for other rows); ``tool`` (n,): the index of a motion's tool pose in ``tools`` (T, 4, 4);
-    ``zone`` (n,) m; ``linear`` (n,) m/s; ``angular`` (n,) rad/s (inf: no limit); ``joint``,
-    ``joint_acceleration`` (n,): fractions of the axes' limits; ``motion`` (n,): whether the row
-    is a motion instruction (resolved or not).
+    ``zone`` (n,) m; ``linear`` (n,) m/s; ``angular`` (n,) rad/s (inf: no limit);
+    ``linear_acceleration`` (n,) m/s² and ``angular_acceleration`` (n,) rad/s² (inf: none);
+    ``joint``, ``joint_acceleration`` (n,): fractions of the axes' limits; ``motion`` (n,):
+    whether the row is a motion instruction (resolved or not).
     """
 
     compiled: CompiledProgram
@@ -58,6 +59,8 @@ class MotionTable:
     angular: FloatArray
     joint: FloatArray
     joint_acceleration: FloatArray
+    linear_acceleration: FloatArray
+    angular_acceleration: FloatArray
 
     @property
     def size(self) -> int:
@@ -101,6 +104,8 @@ class _Builder:
         self.angular = np.full(n, np.inf)
         self.joint = np.ones(n)
         self.joint_acceleration = np.ones(n)
+        self.linear_acceleration = np.full(n, np.inf)
+        self.angular_acceleration = np.full(n, np.inf)
         self.parts: list[FloatArray] = []
         self.part_tools: list[int] = []
         self.samples = 0
@@ -130,6 +135,8 @@ class _Builder:
             angular=self.angular,
             joint=self.joint,
             joint_acceleration=self.joint_acceleration,
+            linear_acceleration=self.linear_acceleration,
+            angular_acceleration=self.angular_acceleration,
         )
 
     def _tool(self, pose: FloatArray) -> int:
@@ -173,6 +180,8 @@ class _Builder:
         self.linear[i] = speed.linear
         self.angular[i] = np.inf if speed.angular is None else speed.angular
         self.joint[i], self.joint_acceleration[i] = speed.joint, speed.joint_acceleration
+        self.linear_acceleration[i] = _or_inf(speed.linear_acceleration)
+        self.angular_acceleration[i] = _or_inf(speed.angular_acceleration)
 
     def _block(self, block: PathBlock) -> None:
         rows = slice(block.start, block.stop)
@@ -189,6 +198,12 @@ class _Builder:
         self.zone[rows] = node.zones
         self.linear[rows] = node.speeds
         self.angular[rows] = np.inf if node.angular is None else node.angular
+        self.linear_acceleration[rows] = _or_inf(node.acceleration)
+        self.angular_acceleration[rows] = _or_inf(node.angular_acceleration)
+
+
+def _or_inf(value: float | None) -> float:
+    return np.inf if value is None else value
 
 
 def travel(table: MotionTable, robot: Robot) -> FloatArray:

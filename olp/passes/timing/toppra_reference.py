@@ -23,17 +23,19 @@ from olp.station.model import JointLimits, Robot
 FloatArray = NDArray[np.float64]
 
 
-_JOINT_CONSTRAINTS: dict[tuple[bytes, bytes], list[constraint.LinearConstraint]] = {}
+_JOINT_CONSTRAINTS: dict[tuple[bytes, bytes, float, float], list[constraint.LinearConstraint]] = {}
 """toppra's joint constraints by limits: they format their limits into a string when made
 (~1 ms), so they are made once."""
 
 
-def _joint_constraints(limits: JointLimits) -> list[constraint.LinearConstraint]:
-    key = (limits.velocity.tobytes(), limits.acceleration.tobytes())
+def _joint_constraints(
+    limits: JointLimits, speed: float = 1.0, accel: float = 1.0
+) -> list[constraint.LinearConstraint]:
+    key = (limits.velocity.tobytes(), limits.acceleration.tobytes(), speed, accel)
     if key not in _JOINT_CONSTRAINTS:
         _JOINT_CONSTRAINTS[key] = [
-            constraint.JointVelocityConstraint(limits.velocity),
-            constraint.JointAccelerationConstraint(limits.acceleration),
+            constraint.JointVelocityConstraint(limits.velocity * speed),
+            constraint.JointAccelerationConstraint(limits.acceleration * accel),
         ]
     return _JOINT_CONSTRAINTS[key]
 
@@ -54,11 +56,13 @@ class _SeidelTOPPRA(algo.TOPPRA):
 
 def toppra_solver(problems: Sequence[PathProblem], robot: Robot) -> list[FloatArray]:
     """The toppra package's TOPPRA, one problem at a time (the reference for
-    :func:`reachability_speeds`); NaN where it finds no time law."""
+    :func:`reachability_speeds`); NaN where it finds no time law. It honours the problems'
+    speed and acceleration scales but not their TCP acceleration limits (the reference
+    predates them)."""
     out = []
     for problem in problems:
         constraints = [
-            *_joint_constraints(robot.limits),
+            *_joint_constraints(robot.limits, 1.0, problem.accel_scale),
             TcpLinearSpeedConstraint(robot, problem.tool, _on_grid(problem.grid, problem.linear)),
         ]
         if np.any(np.isfinite(problem.angular)):
