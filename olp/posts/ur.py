@@ -13,8 +13,9 @@ Conventions shared with frontends (rotation vectors, the flange, no configuratio
   the station's robot (:func:`movej_speed`): at 100 % the leading axis may then run at the
   slowest axis' maximum, so no axis exceeds its own. ``a`` (rad/s²) is URScript's documented
   default 1.4 rad/s² times ``Speed.joint_acceleration`` (:func:`movej_acceleration`): UR
-  publishes no joint acceleration limits, and olp's timing uses the station's limits, which
-  may therefore differ from the controller's motion.
+  publishes no joint acceleration limits. Both come from
+  :func:`olp.vendors.ur.movej_parameters`, which olp's timing of a UR program uses too
+  (:mod:`olp.passes.timing.ur`): the estimate is the trapezoid of the values written.
 * ``movel(p[...], a, v, r)`` / ``movec(p_via, p_to, a, v, r, mode=0)``: the TCP pose in the
   robot's Base frame: the post's manifest says ``frames_in: robot_base``, so the template's
   ``base_pose`` is the target in ``station base · controller_base`` (for UR arms the kinematic
@@ -69,7 +70,12 @@ from olp.ir import ArcOrientation
 from olp.posts.base import Filter, Post
 from olp.posts.numbers import NumberFormat
 from olp.posts.text import NUMBER, ArgumentRule, CommentRule, NameRule
-from olp.vendors.ur import pose_to_ur
+from olp.vendors.ur import (
+    MOTION_DECIMALS,
+    movej_parameters,
+    movel_parameters,
+    pose_to_ur,
+)
 
 if TYPE_CHECKING:
     from olp.compiled import CompiledProgram
@@ -91,10 +97,6 @@ NAME_RULE = NameRule(reserved=KEYWORDS | POST_BUILTINS, case_sensitive=True, pre
 """A legal ``def`` name: ASCII letters, digits and ``_``, a letter first (``p`` is put in front
 otherwise); a keyword, or a function the post calls, gets a trailing ``_``."""
 
-MOVEJ_ACCELERATION = 1.4
-"""rad/s², URScript's ``movej`` default: ``a`` at 100 % joint acceleration."""
-MOVEL_ACCELERATION = 1.2
-"""m/s², URScript's ``movel``/``movec`` default."""
 MAX_MOTIONS = 1000
 """Motions in one script above which a warning asks for splitting or streaming (field reports of
 trouble between ~1,000 and 2,500 targets; low confidence on the exact limit)."""
@@ -105,8 +107,10 @@ NUMBERS: Mapping[str, NumberFormat] = {
     **Post.NUMBERS,
     "position": NumberFormat("position", "m", 6, resolution=1e-5),
     "angle": NumberFormat("angle", "rad", 6, resolution=1e-5),
-    "speed": NumberFormat("speed", "m/s or rad/s", 5, low=0.0, low_open=True),
-    "acceleration": NumberFormat("acceleration", "m/s² or rad/s²", 5, low=0.0, low_open=True),
+    "speed": NumberFormat("speed", "m/s or rad/s", MOTION_DECIMALS, low=0.0, low_open=True),
+    "acceleration": NumberFormat(
+        "acceleration", "m/s² or rad/s²", MOTION_DECIMALS, low=0.0, low_open=True
+    ),
     "radius": NumberFormat("blend radius", "m", 6, low=0.0),
     "sleep": NumberFormat("sleep", "s", 3, 0.0, MAX_SLEEP),
 }
@@ -133,25 +137,26 @@ def ur_joints(post: Post, joints: ArrayLike) -> str:
 
 
 def movej_speed(post: Post, speed: Any, robot: Any) -> str:
-    """``v`` of ``movej`` in rad/s: ``speed.joint`` times the smallest axis velocity limit."""
-    return post.number("speed", speed.joint * float(np.min(robot.limits.velocity)))
+    """``v`` of ``movej`` in rad/s (:func:`olp.vendors.ur.movej_parameters`)."""
+    v = movej_parameters(speed.joint, speed.joint_acceleration, robot.limits.velocity)[1]
+    return post.number("speed", v)
 
 
 def movej_acceleration(post: Post, speed: Any) -> str:
-    """``a`` of ``movej`` in rad/s²: 1.4 rad/s² times ``speed.joint_acceleration``."""
-    return post.number("acceleration", speed.joint_acceleration * MOVEJ_ACCELERATION)
+    """``a`` of ``movej`` in rad/s² (:func:`olp.vendors.ur.movej_parameters`; it does not
+    depend on the axes' limits)."""
+    a = movej_parameters(speed.joint, speed.joint_acceleration, [1.0])[0]
+    return post.number("acceleration", a)
 
 
-def movel_acceleration(post: Post, speed: Any = None) -> str:
-    """``a`` of ``movel``/``movec`` in m/s²: ``speed.linear_acceleration`` where the program sets
-    one (URScript manual, ``movel``: "a: tool acceleration [m/s^2]"), else URScript's default."""
-    accel = None if speed is None else speed.linear_acceleration
-    return post.number("acceleration", MOVEL_ACCELERATION if accel is None else accel)
+def movel_acceleration(post: Post, speed: Any) -> str:
+    """``a`` of ``movel``/``movec`` in m/s² (:func:`olp.vendors.ur.movel_parameters`)."""
+    return post.number("acceleration", movel_parameters(speed.linear, speed.linear_acceleration)[0])
 
 
 def linear_speed(post: Post, speed: Any) -> str:
-    """``v`` of ``movel``/``movec`` in m/s: ``speed.linear``."""
-    return post.number("speed", speed.linear)
+    """``v`` of ``movel``/``movec`` in m/s (:func:`olp.vendors.ur.movel_parameters`)."""
+    return post.number("speed", movel_parameters(speed.linear, speed.linear_acceleration)[1])
 
 
 def radius(post: Post, value: float) -> str:

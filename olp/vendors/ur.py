@@ -74,3 +74,42 @@ def ur_to_pose(values: ArrayLike) -> FloatArray:
     """Poses (..., 4, 4) in metres from ``[x, y, z, rx, ry, rz]`` (..., 6), metres and rad."""
     v = np.asarray(values, dtype=np.float64)
     return pose_from(rotation_from_rotvec(v[..., 3:6]), v[..., :3])
+
+
+# --------------------------------------------------------------------------------------------
+# Motion parameters: what the URScript post writes as ``a`` and ``v``, and what olp's timing
+# of a UR program assumes (olp.passes.timing.ur): one function each, so the two cannot differ.
+
+MOVEJ_ACCELERATION = 1.4
+"""rad/s², URScript's ``movej`` default (``a`` at 100 % joint acceleration)."""
+MOVEL_ACCELERATION = 1.2
+"""m/s², URScript's ``movel``/``movec`` default."""
+MOTION_DECIMALS = 5
+"""Decimals of ``a`` and ``v`` in the script (:data:`olp.posts.ur.NUMBERS`): the values below are
+rounded to them, so the timing uses the numbers the script says."""
+
+
+def movej_parameters(
+    joint: float, joint_acceleration: float, velocity_limits: ArrayLike
+) -> tuple[float, float]:
+    """``(a, v)`` of ``movej``: rad/s² and rad/s of the leading axis (URScript manual,
+    ``movej``: "a: joint acceleration of leading axis [rad/s^2], v: joint speed of leading
+    axis [rad/s]"). ``v`` is ``joint`` (fraction of each axis' maximum) times the *smallest*
+    axis velocity limit, so that at 100 % no axis exceeds its own; ``a`` is 1.4 rad/s² times
+    ``joint_acceleration`` (UR publishes no joint acceleration limits)."""
+    v = joint * float(np.min(np.asarray(velocity_limits, dtype=np.float64)))
+    return _written(joint_acceleration * MOVEJ_ACCELERATION), _written(v)
+
+
+def movel_parameters(linear: float, linear_acceleration: float | None) -> tuple[float, float]:
+    """``(a, v)`` of ``movel``/``movec``: m/s² and m/s of the tool (URScript manual, ``movel``:
+    "a: tool acceleration [m/s^2], v: tool speed [m/s]"): the programmed path acceleration, or
+    URScript's default, and the programmed TCP speed."""
+    a = MOVEL_ACCELERATION if linear_acceleration is None else linear_acceleration
+    return _written(a), _written(linear)
+
+
+def _written(value: float) -> float:
+    """``value`` as the script prints it (positive values stay positive: the post refuses a
+    value that would print as 0)."""
+    return float(round(value, MOTION_DECIMALS))

@@ -23,7 +23,7 @@ from olp.compiled import CompiledProgram, PathBlock, RowTrajectories, Step, item
 from olp.compiled import span_of as _span
 from olp.diagnostics import Diagnostic
 from olp.ir import is_motion
-from olp.passes.timing import jerk, ptp
+from olp.passes.timing import jerk, ptp, ur
 from olp.passes.timing.chains import PATH_SOLVERS, path_problem, time_law
 from olp.passes.timing.geometry import joined_geometry
 from olp.passes.timing.lines import line_profiles, straight_samples
@@ -150,9 +150,16 @@ def time_fixed(table: MotionTable, times: Mapping[str, float], out: Times) -> No
 
 
 def time_joints(table: MotionTable, lengths: FloatArray, out: Times) -> list[Diagnostic]:
-    """Joint moves, one Ruckig profile each."""
-    robot, found = table.compiled.station.robot, []
+    """Joint moves, one Ruckig profile each (on a UR arm: the trapezoid of the ``movej``
+    written, :mod:`~olp.passes.timing.ur`)."""
+    robot, found = table.compiled.station.robot, list[Diagnostic]()
+    on_ur = ur.applies(table)
     for i in np.flatnonzero(table.kind == JOINT).tolist():
+        law = ur.movej_law(table, i) if on_ur else None
+        if law is not None:
+            _fill(out, np.array([i]), out.add_law(law), np.array([0.0, law.duration]))
+            out.length[i] = lengths[i]
+            continue
         q0, q1 = table.q[table.lo[i]], table.q[table.hi[i]]
         try:
             profile = ptp.ptp_profile(
@@ -179,6 +186,14 @@ def time_paths(
     firsts = corners.rows[corners.bounds[:-1]]
     lone = (sizes == 1) & ~below_floor(table, firsts)  # a too-slow move: the chain timer says so
     done = np.zeros(sizes.size, dtype=bool)
+    if ur.applies(table) and np.any(lone):
+        rows = ur.movel_rows(table, lengths, firsts[lone])
+        for i in rows.tolist():
+            law = ur.movel_law(table, lengths, i, options)
+            _fill(out, np.array([i]), out.add_law(law), np.array([0.0, law.duration]))
+            out.length[i] = lengths[i]
+        done = np.isin(firsts, rows)
+        lone &= ~done
     if options.straight_lines and np.any(lone):
         done[lone] = time_lines(table, lengths, firsts[lone], options, out)
     return time_chains(table, corners, np.flatnonzero(~done), options, out)
