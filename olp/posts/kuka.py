@@ -285,7 +285,8 @@ class KukaPost(Post):
         """* ``zone_dropped`` (warning): without the option ``ptp_approximation`` (a
           ``$APO.CPTP`` percentage), joint moves with a zone are written as exact stops: KRL
           approximates PTP with ``C_PTP`` and ``$APO.CPTP`` in percent of an axis-specific
-          distance, which a TCP distance zone does not translate to (timing assumes stops).
+          distance, which a TCP distance zone does not translate to (olp's estimate blends
+          the corner, :mod:`olp.passes.timing.ptp_blend`: the program written is slower).
         * ``joint_speed`` (error): a joint speed or acceleration below 1 %; (warning) one that
           is not a whole percent, written rounded down (:func:`krl_percent`).
         * ``ptp_axis_values`` (warning): a PTP to a Cartesian target written as axis values,
@@ -318,7 +319,8 @@ def _joint_checks(index: int, ins: Any, options: Mapping[str, Any]) -> list[Diag
             Diagnostic(
                 "warning",
                 "zone_dropped",
-                f"PTP with a {ins.zone.radius * 1000:.1f} mm zone is written as an exact stop",
+                f"PTP with a {ins.zone.radius * 1000:.1f} mm zone is written as an exact stop "
+                "(the cycle time estimate blends it)",
                 ins.span,
                 index,
             )

@@ -471,19 +471,6 @@ def test_blend_rounds_the_corner_like_the_parabola_of_the_model(
     assert np.min(distance) == pytest.approx(d * math.sqrt(2) / 4, rel=0.02)
 
 
-def test_zone_on_a_joint_move_is_a_stop_with_a_note(station: Station, tool: ir.Tool) -> None:
-    q1 = Q0 + np.radians([40, 10, -10, 30, 20, 50])
-    moves = [
-        ir.JointMove(target=ir.JointTarget(joints=q1), tool=tool, zone=ir.Zone(0.05)),
-        ir.JointMove(target=ir.JointTarget(joints=Q0), tool=tool, zone=ir.Zone(0.05)),
-    ]
-    fine = [dataclasses.replace(m, zone=ir.FINE) for m in moves]
-    with_zones, without = _compiled(station, tool, *moves), _compiled(station, tool, *fine)
-    assert with_zones.cycle_time == pytest.approx(without.cycle_time, rel=1e-12)
-    notes = [d for d in with_zones.diagnostics if d.kind == "zone_stop"]
-    assert [(d.severity, d.index) for d in notes] == [("info", 1)]  # the last motion stops anyway
-
-
 def test_a_comment_keeps_a_blend_an_output_breaks_it(station: Station, tool: ir.Tool) -> None:
     a = _lin(station, tool, [0.0, 0.1, 0.0], 0.5, 0.02)
     b = _lin(station, tool, [0.1, 0.1, 0.0], 0.5)

@@ -64,10 +64,16 @@ The model, point by point (each choice is what the estimate can be explained by)
   needs no IK and stays inside the joint limits (the box of limits is convex); its TCP curve
   deviates from a vendor's Cartesian blend by second-order terms in ``d``.
 * **Stops** — fine points stop. So do: a corner with ``d < 1 um`` (a move without TCP travel),
-  a tool change, and any instruction other than a comment between two moves. **PTP zones and
-  PTP-LIN blends are timed as stops**: a controller's joint-space blend follows rules no vendor
-  publishes, and a state-to-state model would need a pass-through velocity that olp would have
-  to guess. Such a program's estimate is an upper bound (shown in the summary).
+  a tool change, and any instruction other than a comment between two moves. **PTP-LIN
+  blends are timed as stops** (a controller's switch from joint to path interpolation follows
+  rules no vendor publishes): such a program's estimate is an upper bound (shown in the
+  summary).
+* **Blended joint moves** (PTP approximation) — a joint move with a zone followed by a joint
+  move leaves its line ``min(r, L1/2, L2/2)`` of TCP travel before the corner and Ruckig
+  takes it, from that state, to the next target (:mod:`~olp.passes.timing.ptp_blend`;
+  checked against Ruckig through the corner). On a UR arm blended ``movej`` stay stops.
+* **UR arms** — joint moves and stop-to-stop path moves are the trapezoids of the ``a`` and
+  ``v`` the URScript post writes (:mod:`~olp.passes.timing.ur`).
 * **TCP accelerations** — a path move's ``Speed.linear_acceleration`` (KUKA ``$ACC.CP``, ABB
   ``PathAccLim``, UR ``movel`` ``a``) bounds the TCP's acceleration along its path,
   ``|r s̈ + r' ṡ²| <= a`` with ``r = |J_v q'|``, and ``angular_acceleration`` (``$ACC.ORI1``)

@@ -23,7 +23,7 @@ from olp.compiled import CompiledProgram, PathBlock, RowTrajectories, Step, item
 from olp.compiled import span_of as _span
 from olp.diagnostics import Diagnostic
 from olp.ir import is_motion
-from olp.passes.timing import jerk, ptp, ur
+from olp.passes.timing import jerk, ptp, ptp_blend, ur
 from olp.passes.timing.chains import PATH_SOLVERS, path_problem, time_law
 from olp.passes.timing.geometry import joined_geometry
 from olp.passes.timing.lines import line_profiles, straight_samples
@@ -48,7 +48,14 @@ from olp.passes.timing.table import (
     travel,
 )
 from olp.station.model import Robot
-from olp.trajectory import LineLaws, PathTimeLaw, Segment, SmoothedTimeLaw, TimeLaw
+from olp.trajectory import (
+    JerkProfile,
+    LineLaws,
+    PathTimeLaw,
+    Segment,
+    SmoothedTimeLaw,
+    TimeLaw,
+)
 
 if TYPE_CHECKING:
     from olp.passes.pipeline import BuildOptions
@@ -131,12 +138,15 @@ def time_program(
     time_fixed(table, time_table(other_times), times)
     found = time_joints(table, lengths, times)
     found += time_paths(table, lengths, corners, opts, times)
+    joint_blends = None if ur.applies(table) else ptp_blend.blended_joint_moves(table, lengths)
     found.sort(key=lambda d: d.index if d.index is not None else -1)
     found += _overflow(compiled, times.duration)
     return dataclasses.replace(
         compiled,
         steps=write_back(compiled, times),
-        diagnostics=compiled.diagnostics + tuple(found) + tuple(zone_stops(table, corners)),
+        diagnostics=compiled.diagnostics
+        + tuple(found)
+        + tuple(zone_stops(table, corners, joint_blends)),
     )
 
 
@@ -151,26 +161,51 @@ def time_fixed(table: MotionTable, times: Mapping[str, float], out: Times) -> No
 
 def time_joints(table: MotionTable, lengths: FloatArray, out: Times) -> list[Diagnostic]:
     """Joint moves, one Ruckig profile each (on a UR arm: the trapezoid of the ``movej``
-    written, :mod:`~olp.passes.timing.ur`)."""
-    robot, found = table.compiled.station.robot, list[Diagnostic]()
+    written, :mod:`~olp.passes.timing.ur`); a joint move blended into the next one ends where
+    its blend starts, and the next starts from that state
+    (:mod:`~olp.passes.timing.ptp_blend`)."""
+    found = list[Diagnostic]()
     on_ur = ur.applies(table)
+    blends = np.zeros(table.size) if on_ur else ptp_blend.blended_joint_moves(table, lengths)
+    state: tuple[FloatArray, FloatArray, FloatArray] | None = None
     for i in np.flatnonzero(table.kind == JOINT).tolist():
         law = ur.movej_law(table, i) if on_ur else None
         if law is not None:
             _fill(out, np.array([i]), out.add_law(law), np.array([0.0, law.duration]))
             out.length[i] = lengths[i]
             continue
-        q0, q1 = table.q[table.lo[i]], table.q[table.hi[i]]
         try:
-            profile = ptp.ptp_profile(
-                q0, q1, robot, float(table.joint[i]), float(table.joint_acceleration[i])
-            )
+            profile, end, state = _joint_move(table, lengths, i, float(blends[i]), state)
         except TimingError as exc:
             found.append(Diagnostic("error", "timing", str(exc), _span(table.compiled.steps, i), i))
+            state = None
             continue
-        _fill(out, np.array([i]), out.add_law(profile), np.array([0.0, profile.duration]))
+        _fill(out, np.array([i]), out.add_law(profile), np.array([0.0, end]))
         out.length[i] = lengths[i]
     return found
+
+
+def _joint_move(
+    table: MotionTable,
+    lengths: FloatArray,
+    i: int,
+    blend: float,
+    state: tuple[FloatArray, FloatArray, FloatArray] | None,
+) -> tuple[JerkProfile, float, tuple[FloatArray, FloatArray, FloatArray] | None]:
+    """Joint move ``i``: its profile (from rest, or from the ``state`` a blend handed over), the
+    time it ends at (its blend's start, or the profile's end), and the state it hands over."""
+    robot = table.compiled.station.robot
+    q0, q1 = table.q[table.lo[i]], table.q[table.hi[i]]
+    scales = float(table.joint[i]), float(table.joint_acceleration[i])
+    if state is None:
+        profile = ptp.ptp_profile(q0, q1, robot, *scales)
+    else:
+        profile = ptp_blend.profile_from(*state, q1, robot, *scales)
+    if blend <= 0.0 or lengths[i] <= 0.0:
+        return profile, profile.duration, None
+    start = ptp_blend.blend_start(profile, q0, q1, blend / float(lengths[i]))
+    q, qd, qdd = profile.state(np.array([start]))
+    return profile, start, (q[0], qd[0], qdd[0])
 
 
 def time_paths(
@@ -419,13 +454,19 @@ def _overflow(compiled: CompiledProgram, durations: FloatArray) -> list[Diagnost
     return [Diagnostic("error", "timing", msg, _span(compiled.steps, i), i)]
 
 
-def zone_stops(table: MotionTable, corners: Plan) -> list[Diagnostic]:
+def zone_stops(
+    table: MotionTable, corners: Plan, joint_blends: FloatArray | None = None
+) -> list[Diagnostic]:
     """An info diagnostic for every zone that the model times as an exact stop although a
-    motion follows (after the last motion the robot stops anyway)."""
+    motion follows (after the last motion the robot stops anyway); ``joint_blends`` (n,) m:
+    the joint moves' blends (:func:`~olp.passes.timing.ptp_blend.blended_joint_moves`)."""
     motions = np.flatnonzero(table.motion)
     if motions.size == 0:
         return []
-    stops = (table.kind >= JOINT) & (table.zone > 0) & (corners.blend <= 0)
+    blended = corners.blend > 0
+    if joint_blends is not None:
+        blended |= joint_blends > 0
+    stops = (table.kind >= JOINT) & (table.zone > 0) & ~blended
     stops[motions[-1]] = False
     found = []
     for i in np.flatnonzero(stops).tolist():
@@ -442,7 +483,8 @@ _PATH_STOP = "the next motion is not a path move with the same tool, or the corn
 
 
 _STOP_REASON = {
-    "joint": "olp does not model joint-move blending",
+    "joint": "the next motion is not a joint move, the corner is too short, or the robot is a "
+    "UR arm, whose blended movej olp times as stops",
     "linear": _PATH_STOP,
     "circular": _PATH_STOP,
 }
