@@ -156,13 +156,15 @@ def write_outputs(args: argparse.Namespace, result: BuildResult) -> None:
 # The program and its options
 
 
-def add_program(parser: argparse.ArgumentParser) -> None:
-    """The ``program`` argument: a file of any frontend's suffix."""
+def add_program(parser: argparse.ArgumentParser, optional: bool = False) -> None:
+    """The ``program`` argument: a file of any frontend's suffix (``optional``: may be left
+    out, for a subcommand that has another mode)."""
     from olp.frontends import frontends
 
     kinds = ", ".join(f"{' '.join(f.SUFFIXES)} {f.TITLE}" for f in frontends().values())
     parser.add_argument(
         "program",
+        nargs="?" if optional else None,
         help=f"program file ({kinds}). A .py program is code that olp runs, with your rights "
         "(in a child process, stopped after --timeout)",
     )

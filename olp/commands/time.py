@@ -6,6 +6,12 @@ of every path move (LIN, CIRC), ``--sweep-joint`` the joint speed (% of each axi
 every joint move. Accelerations and orientation-speed limits stay as programmed. Without one of
 the two options, that dimension keeps the programmed speeds.
 
+``olp time STATION --calibrate LOG.csv [--output OVERRIDE.yaml]`` fits the station robot's
+per-axis velocity, acceleration and jerk limits to a recorded joint trajectory (olp's own
+trajectory CSV, or a UR RTDE recording) and writes them as a station override (printed without
+``--output``), with the residual of re-timing the recording with them
+(:mod:`olp.passes.timing.calibrate`).
+
 Exit codes as for ``olp build``: 0 timed, 1 the program has errors, 2 bad input.
 """
 
@@ -41,7 +47,17 @@ OVERRIDABLE = ("set_output", "wait_input", "call", "comment")
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("station", help="station YAML file")
-    add_program(parser)
+    add_program(parser, optional=True)
+    parser.add_argument(
+        "--calibrate",
+        metavar="LOG.csv",
+        help="instead of a program: fit the robot's joint velocity, acceleration and jerk "
+        "limits to this recorded trajectory (time_s + j1_deg.. columns, or UR RTDE's timestamp "
+        "+ actual_q_0..) and print them as a station override",
+    )
+    parser.add_argument(
+        "--output", metavar="YAML", help="with --calibrate: write the station override here"
+    )
     parser.add_argument(
         "--sweep-linear",
         metavar="MM_S,...",
@@ -77,6 +93,10 @@ def run(args: argparse.Namespace) -> int:
     from olp import progress
     from olp.api import compile, load_station
 
+    if args.calibrate is not None or args.program is None:
+        return calibrate(args)
+    if args.output is not None:
+        raise UsageError("--output goes with --calibrate")
     require_files(args.station, args.program)
     linear = _speed_list(args.sweep_linear, "--sweep-linear", "mm/s", 1e-3)
     joint = _speed_list(args.sweep_joint, "--sweep-joint", "%", 1e-2, upper=1.0)
@@ -106,6 +126,38 @@ def run(args: argparse.Namespace) -> int:
     if linear or joint:
         _print_sweep(compiled, linear, joint, other_times, args.quiet)
     _write_outputs(compiled, args)
+    return EXIT_OK
+
+
+def calibrate(args: argparse.Namespace) -> int:
+    """``--calibrate``: fit, print the fit and write (or print) the station override."""
+    from pathlib import Path
+
+    from olp.api import load_station
+    from olp.output import check_output_file
+    from olp.passes.timing.calibrate import fit_limits, override_yaml, read_recording
+    from olp.trajectory import write_atomic
+
+    if args.calibrate is None or args.program is not None:
+        raise UsageError("give either a program to time or --calibrate LOG.csv, not both")
+    require_files(args.station, args.calibrate)
+    output = check_output_file(args.output, "--output") if args.output else None
+    station = load_station(args.station)
+    text = Path(args.calibrate).read_text(encoding="utf-8", errors="replace")
+    recording = read_recording(text, args.calibrate, station.robot.dof)
+    fitted = fit_limits(recording, station.robot)
+    override = override_yaml(fitted, Path(args.calibrate).name)
+    print(
+        f"fitted {station.robot.name} to {fitted.moves} recorded move(s): re-timed "
+        f"{fitted.retimed:.3f} s against {fitted.recorded:.3f} s recorded "
+        f"(residual {fitted.residual * 100:+.2f} %)"
+    )
+    if output is None:
+        print(override, end="")
+    else:
+        write_atomic(output, override.encode("utf-8"))
+        if not args.quiet:
+            print(f"written: {output}")
     return EXIT_OK
 
 

@@ -1,0 +1,121 @@
+"""``olp time --calibrate``: a round trip (a trajectory generated with known limits, written as
+olp's trajectory CSV, fitted: the limits recovered within 2% and the recorded cycle time
+reproduced within 1%), the station override it writes loads, and bad recordings are errors."""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import olp
+from olp import ir
+from olp.commands import time as time_command
+from olp.errors import UsageError
+from olp.passes.timing.calibrate import fit_limits, read_recording
+from olp.station.model import JointLimits, Station
+from olp.trajectory import csv_text, sample_program
+
+REPO = Path(__file__).resolve().parents[2]
+CELL = REPO / "stations" / "kr6_milling_cell.yaml"
+HOME = np.radians([0, -90, 90, 0, 45, 0])
+VELOCITY = np.radians([60, 50, 70, 80, 90, 120])
+ACCELERATION = 2.5 * VELOCITY
+JERK = 10.0 * ACCELERATION
+
+
+@pytest.fixture(scope="module")
+def station() -> Station:
+    """The KR 6 cell with known, slower limits (every axis cruises on a 70° move)."""
+    base = olp.load_station(CELL)
+    lim = base.robot.limits
+    limits = JointLimits(lim.lower, lim.upper, VELOCITY, ACCELERATION, JERK)
+    return dataclasses.replace(base, robot=dataclasses.replace(base.robot, limits=limits))
+
+
+@pytest.fixture(scope="module")
+def recording(station: Station) -> str:
+    """Each axis alone 70° out and back (A3 down: up is beyond its range), then two moves of
+    all axes: olp's trajectory CSV."""
+    targets = [HOME]
+    for axis in range(6):
+        out = HOME.copy()
+        out[axis] += np.radians(-70 if axis == 2 else 70)
+        targets += [out, HOME]
+    targets += [HOME + np.radians([20, -10, 15, 30, -20, 40]), HOME]
+    moves = [ir.JointMove(target=ir.JointTarget(joints=q)) for q in targets]
+    compiled = olp.compile(ir.Program(name="rec", instructions=moves), station)
+    assert compiled.ok
+    return csv_text(sample_program(compiled, dt=0.004)), compiled.cycle_time
+
+
+def test_round_trip_recovers_the_limits(station: Station, recording: tuple[str, float]) -> None:
+    text, cycle = recording
+    fitted = fit_limits(read_recording(text, "rec.csv", 6), station.robot)
+    assert fitted.velocity == pytest.approx(VELOCITY, rel=2e-2)
+    assert fitted.acceleration == pytest.approx(ACCELERATION, rel=2e-2)
+    assert fitted.jerk == pytest.approx(JERK, rel=2e-2)
+    assert fitted.moves == 15  # the first from the station's home
+    assert abs(fitted.residual) < 1e-2
+    assert fitted.recorded == pytest.approx(cycle, rel=1e-2)
+
+
+def _olp_time(*argv: str | Path) -> int:
+    parser = argparse.ArgumentParser(prog="olp time")
+    time_command.add_arguments(parser)
+    return time_command.run(parser.parse_args([str(a) for a in argv]))
+
+
+def test_the_override_loads_and_reproduces_the_recording(
+    station: Station,
+    recording: tuple[str, float],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    log = tmp_path / "rec.csv"
+    log.write_text(recording[0])
+    override = tmp_path / "override.yaml"
+    assert _olp_time(CELL, "--calibrate", log, "--output", override) == 0
+    assert "residual" in capsys.readouterr().out
+    text = override.read_text()
+    calibrated = tmp_path / "calibrated.yaml"
+    cell = CELL.read_text().replace(
+        "  model: kuka/kr6_r900_sixx\n",
+        "  model: kuka/kr6_r900_sixx\n" + text.split("robot:\n", 1)[1],
+    )
+    calibrated.write_text(cell)
+    loaded = olp.load_station(calibrated)
+    assert loaded.robot.limits.velocity == pytest.approx(VELOCITY, rel=2e-2)
+    assert loaded.robot.limits.jerk == pytest.approx(JERK, rel=2e-2)
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("a,b\n1,2\n", "expected the columns"),
+        ("time_s,j1_deg,j2_deg,j3_deg,j4_deg,j5_deg,j6_deg\n0,1,2,3,4,5,6\n", "at least 16"),
+        (
+            "time_s,j1_deg,j2_deg,j3_deg,j4_deg,j5_deg,j6_deg\n"
+            + "".join(f"{t},1,2,3,4,5,x\n" for t in range(20)),
+            "rec.csv:2: expected numbers",
+        ),
+        (
+            "time_s,j1_deg,j2_deg,j3_deg,j4_deg,j5_deg,j6_deg\n"
+            + "".join(f"{t % 10},1,2,3,4,5,6\n" for t in range(20)),
+            "rec.csv:12: times must increase",
+        ),
+    ],
+)
+def test_bad_recordings_are_usage_errors(text: str, message: str) -> None:
+    with pytest.raises(UsageError, match=message):
+        read_recording(text, "rec.csv", 6)
+
+
+def test_rtde_columns_in_radians(station: Station) -> None:
+    rows = ["timestamp actual_q_0 actual_q_1 actual_q_2 actual_q_3 actual_q_4 actual_q_5"]
+    rows += [f"{0.002 * k} {0.01 * k} 0 0 0 0 0" for k in range(20)]
+    recording = read_recording("\n".join(rows), "rtde.csv", 6)
+    assert recording.q[5, 0] == pytest.approx(0.05) and recording.t[5] == pytest.approx(0.01)
