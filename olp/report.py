@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 import os
+import textwrap
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -132,24 +133,87 @@ def _path_length(compiled: CompiledProgram) -> float:
     return float(sum(step.path_length for step in compiled.steps))
 
 
-def _timing_note(compiled: CompiledProgram) -> str:
-    """How to read the cycle time: time-optimal, or an upper bound where zones became stops."""
+def _timing_note(compiled: CompiledProgram, pointer: bool = True) -> str:
+    """How to read the cycle time: an estimate, an upper bound where zones became stops."""
     stops = sum(1 for d in compiled.diagnostics if d.kind == "zone_stop")
     if stops:
         return f"estimate; upper bound: {stops} zone{'s' * (stops > 1)} timed as exact stops"
-    return "estimate: time-optimal under the station's limits"
+    return "estimate; olp time says what it includes" if pointer else "estimate"
 
 
 def timing_summary(compiled: CompiledProgram) -> str:
-    """Program, station, cycle time and path length, one per line (``olp time``)."""
+    """Program, station, cycle time and path length, one per line (``olp time``), then what the
+    estimate includes and leaves out, once, in plain words (:func:`estimate_scope`)."""
+    includes, excludes = estimate_scope(compiled)
     rows = [
         ("program", f"{compiled.program.name} ({compiled.program.source})"),
         ("station", f"{compiled.station.name} ({compiled.station.robot.name})"),
-        ("cycle time", f"{quantity(compiled.cycle_time, 3)} s ({_timing_note(compiled)})"),
+        ("cycle time", f"{quantity(compiled.cycle_time, 3)} s ({_timing_note(compiled, False)})"),
         ("path length", f"{_path_length(compiled) * 1000:.1f} mm of TCP travel"),
+        ("includes", includes),
+        ("excludes", excludes),
     ]
     width = max(len(k) for k, _ in rows)
-    return "\n".join(f"{k.ljust(width)}  {v}" for k, v in rows)
+    indent = " " * (width + 2)
+    return "\n".join(
+        textwrap.fill(v, 96, initial_indent=f"{k.ljust(width)}  ", subsequent_indent=indent)
+        for k, v in rows
+    )
+
+
+def estimate_scope(compiled: CompiledProgram) -> tuple[str, str]:
+    """What the cycle time of ``compiled`` includes and what it leaves out, as two sentences in
+    plain words, naming only the kinds of motion the program has (the model is
+    :mod:`olp.passes.timing`'s default: jerk-limited path moves)."""
+    moves = [s.instruction for s in compiled.steps if is_motion(s.instruction)]
+    joint = [m for m in moves if m.kind == "joint"]
+    path = [m for m in moves if m.kind != "joint"]
+    on_ur = compiled.station.robot.vendor == "ur"
+    parts = []
+    if joint and on_ur:
+        parts.append("joint moves as the movej trapezoid of the a and v the script writes")
+    elif joint:
+        blended = (
+            " (blended ones cut their corners by their zones)"
+            if any(not m.zone.is_fine for m in joint)
+            else ""
+        )
+        parts.append(
+            "joint moves at the shortest time within the robot's axis speed, acceleration and "
+            f"jerk limits, scaled by the programmed percentages{blended}"
+        )
+    if path and on_ur:
+        parts.append(
+            "stop-to-stop linear and circular moves as the tool trapezoid of the a and v the "
+            "script writes, blended ones like other robots' path moves"
+        )
+    elif path:
+        accels = any(
+            m.speed.linear_acceleration is not None or m.speed.angular_acceleration is not None
+            for m in path
+        )
+        extra = ", path accelerations" if accels else ""
+        parts.append(
+            "linear and circular moves at the shortest time within the axis limits (jerk "
+            f"included) and the programmed TCP speed{extra}, zones rounded as blends"
+        )
+    parts.append("other instructions at fixed times (a wait its own)")
+    excludes = (
+        "the controller's look-ahead, interpolation cycle and filters, servo lag and "
+        "settling at exact stops, payload and motor-torque limits, and the time of I/O and "
+        "called routines beyond the fixed times"
+    )
+    stops = sum(1 for d in compiled.diagnostics if d.kind == "zone_stop")
+    if stops:
+        excludes += (
+            f"; {stops} zone{'s' * (stops > 1)} that olp cannot blend (a joint move into a "
+            "path move, or a UR movej) count as exact stops, so the total is an upper bound there"
+        )
+    return _sentence("; ".join(parts)), _sentence(excludes)
+
+
+def _sentence(text: str) -> str:
+    return text[:1].upper() + text[1:] + "."
 
 
 def timing_table(compiled: CompiledProgram) -> str:
