@@ -249,6 +249,13 @@ class SmoothedTimeLaw:
         dq, ddq = self.path(s, 1), self.path(s, 2)
         return self.path(s), dq * sd[:, None], ddq * (sd**2)[:, None] + dq * sdd[:, None]
 
+    def rates(self, t: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """Joint velocity and acceleration (T, dof) at times ``t`` (T,) s (:meth:`state`
+        without the positions)."""
+        s, sd, sdd = self.path_state(t)
+        dq, ddq = self.path(s, 1), self.path(s, 2)
+        return dq * sd[:, None], ddq * (sd**2)[:, None] + dq * sdd[:, None]
+
 
 def _ramp_state(
     t: FloatArray, jerk_time: Any, ramp: Any, accel: Any

