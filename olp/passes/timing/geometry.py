@@ -143,9 +143,30 @@ def joined_geometry(
     end = (entries[0][1:], entries[1][1:])
     counts = _blend_counts(start[1], end[1], d, samples.spacing(), blend_samples)
     curves = _blend_curves(start, end, d, counts)
-    inner = (samples.arc > enter[samples.move] + 1e-9) & (samples.arc < leave[samples.move] - 1e-9)
+    inner = _inner(samples, enter, np.concatenate([d, [0.0]]))
+    # An end without a blend is the move's own end sample, whatever its TCP travel: a move
+    # that only turns the tool has none, and a cut by travel would pick a sample at random.
+    last = samples.first + samples.sizes - 1
+    no_entry, no_exit = enter <= 0.0, np.concatenate([d, [0.0]]) <= 0.0
+    entries[0][no_entry] = samples.q[samples.first[no_entry]]
+    exits[0][no_exit] = samples.q[last[no_exit]]
     q, marks = _assemble(samples, inner, entries[0], exits[0], curves, counts - 2)
     return _geometry(q, marks, robot, tool)
+
+
+def _inner(samples: _Samples, enter: FloatArray, leave_blend: FloatArray) -> NDArray[np.bool_]:
+    """The samples (S,) kept between each move's ends: beyond its entry blend and before its
+    exit blend by TCP travel where it has those blends, else all but its first and last (a
+    move without TCP travel, a pure turn of the tool, keeps its samples)."""
+    own = samples.move
+    index = np.arange(own.size)
+    first = samples.first[own]
+    last = first + samples.sizes[own] - 1
+    leave = samples.lengths[own] - leave_blend[own]
+    after_entry = (samples.arc > enter[own] + 1e-9) | (enter[own] <= 0.0)
+    before_exit = (samples.arc < leave - 1e-9) | (leave_blend[own] <= 0.0)
+    inner: NDArray[np.bool_] = (index > first) & (index < last) & after_entry & before_exit
+    return inner
 
 
 _BLEND_TURN_PER_SAMPLE = float(np.radians(4.0))
