@@ -62,6 +62,7 @@ from olp.posts.text import (
 if TYPE_CHECKING:
     from olp.compiled import CompiledProgram, Step
     from olp.posts.manifest import PostManifest
+    from olp.posts.rows import PostRows
     from olp.posts.view import PostStep
 
 FloatArray = NDArray[np.float64]
@@ -139,10 +140,13 @@ class Post:
     move's line, never a different path."""
     ARC_ANGLE: ClassVar[bool] = False
     """Whether a circular move's circular angle (KUKA's CA) can be written."""
+    ROWS: ClassVar[bool] = False
+    """Whether the post writes runs of linear moves with a row writer (:mod:`olp.posts.rows`);
+    used only where the template folder says ``rows: true`` and :meth:`rows_enabled` agrees."""
 
     def __init__(self, manifest: PostManifest) -> None:
         self.manifest = manifest
-        self.current_step: PostStep | None = None
+        self.current_step: PostStep | PostRows | None = None
         self.problems: list[Diagnostic] = []
         self.collecting = False
         """While rendering: numbers that cannot be written are collected as diagnostics on the
@@ -239,6 +243,36 @@ class Post:
         """``value`` in the printed unit of ``quantity`` (``NUMBERS``), checked; a value that
         cannot be written becomes an error on the instruction being written."""
         return self.number_with(self.NUMBERS[quantity], value)
+
+    def number_column(self, quantity: str, values: Any, steps: Sequence[PostStep]) -> list[str]:
+        """:meth:`number` for values (n, k) or (n,), row r belonging to ``steps[r]``: spelled and
+        checked as one column (:func:`~olp.posts.numbers.format_numbers`); a value that cannot
+        be written is an error on its own row's instruction. Row-major, n * k texts."""
+        v = np.asarray(values, dtype=np.float64)
+        fmt = self.NUMBERS[quantity]
+        try:
+            return format_numbers(v, fmt)
+        except NumberError:
+            pass
+        saved, out = self.current_step, []
+        per_row = v.reshape(len(steps), -1)
+        for step, row in zip(steps, per_row, strict=True):
+            self.current_step = step
+            out += [self.number_with(fmt, float(x)) for x in row]
+        self.current_step = saved
+        return out
+
+    def rows_enabled(self) -> bool:
+        """Whether runs of linear moves go to the row writer: the post has one, the template
+        folder declares ``rows: true``, and (per brand) the options allow it."""
+        return self.ROWS and self.manifest.rows
+
+    def group(self, steps: Sequence[PostStep]) -> list[PostStep | PostRows]:
+        """A file's steps as its templates see them (:func:`olp.posts.rows.group_rows` where
+        :meth:`rows_enabled`)."""
+        from olp.posts.rows import group_rows
+
+        return group_rows(steps) if self.rows_enabled() else list(steps)
 
     def numbers(self, quantity: str, values: Any) -> list[str]:
         """:meth:`number` for an array of values (N,)."""

@@ -51,6 +51,7 @@ from typing import TYPE_CHECKING, Any
 from olp import progress
 from olp.diagnostics import Diagnostic
 from olp.errors import PostError
+from olp.posts.rows import PostRows
 from olp.posts.text import basename
 from olp.posts.view import Allocation, Modal, Names, PostFrame, PostStep, PostTool, ProgramView
 from olp.transforms.split import SplitLimits, part_names, split_steps
@@ -68,14 +69,14 @@ class RenderError(Exception):
         self.diagnostics = tuple(diagnostics)
 
 
-class TrackedSteps(list[PostStep]):
+class TrackedSteps(list[PostStep | PostRows]):
     """A file's steps; iterating them tells the post which instruction is being written."""
 
-    def __init__(self, steps: Sequence[PostStep], post: Post) -> None:
+    def __init__(self, steps: Sequence[PostStep | PostRows], post: Post) -> None:
         super().__init__(steps)
         self.post = post
 
-    def __iter__(self) -> Iterator[PostStep]:
+    def __iter__(self) -> Iterator[PostStep | PostRows]:
         for step in super().__iter__():
             self.post.current_step = step
             yield step
@@ -221,7 +222,7 @@ class _Renderer:
                 "is_main": index == 0,
             },
             "parts": [],
-            "steps": TrackedSteps(view, self.post),
+            "steps": TrackedSteps(self.post.group(view), self.post),
             "tools": tools,
             "frames": frames,
             "vendor": self.post.context_values(view),
