@@ -34,6 +34,16 @@ Units and conventions (those of the RoboDK API, whose names robot programmers kn
   for CSV files. ``SolveIK`` keeps RoboDK's meaning: a flange pose in the robot base frame.
 * Inside olp everything is converted to SI at the call; :class:`Mat` never leaves this module.
 
+RoboDK scripts
+--------------
+A script written against RoboDK's API runs unchanged: ``from robolink import *``,
+``from robodk import *`` and the newer ``robodk.robolink`` / ``robodk.robomath`` paths are
+importable inside a program olp runs (:mod:`olp.compat`; ``Robolink()``, ``RDK.Item(name)``
+over the station's named robot, tools, frames, objects and ``targets:``, run modes with
+``TargetReachError``, program items). ``docs/robodk.md`` maps every call to what olp does.
+The class :class:`Robot` below is what both APIs record with; ``help(olp.dsl)`` lists its
+methods.
+
 Questions a program may ask the station (jobs 2 and 6): :meth:`Robot.Joints`,
 :meth:`Robot.Pose`, :meth:`Robot.SolveIK`, :meth:`Robot.MoveL_Test`, :meth:`Robot.MoveJ_Test`
 (RoboDK's names and return codes) and :meth:`Robot.canReach` / :meth:`Robot.canMoveL` /
@@ -77,6 +87,12 @@ INSTRUCTION_COMMENT = 3
 INSTRUCTION_SHOW_MESSAGE = 4
 
 __all__ = [
+    "DslError",
+    "Feasibility",
+    "FrameItem",
+    "Robot",
+    "Target",
+    "ToolItem",
     "INSTRUCTION_CALL_PROGRAM",
     "INSTRUCTION_COMMENT",
     "INSTRUCTION_INSERT_CODE",
@@ -474,6 +490,7 @@ class Feasibility:
     reason: str = ""
     kind: str = ""
     count: int = 0
+    """How many error diagnostics the move raised (e.g. colliding pairs)."""
 
     def __bool__(self) -> bool:
         return self.ok
@@ -520,7 +537,11 @@ characters: linear in the text (``\\s*;?\\s*`` backtracks cubically on a long ru
 
 
 class Robot:
-    """The recorder behind ``robot`` (RoboDK's ``Item`` methods for a robot or program)."""
+    """The recorder behind ``robot`` (RoboDK's ``Item`` methods for a robot or program).
+
+    ``instructions``: the list it records into (default: the session's program; a RoboDK
+    program item has its own).
+    """
 
     def __init__(self, session: Session, instructions: list[ir.Instruction] | None = None) -> None:
         self._s = session

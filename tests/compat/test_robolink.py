@@ -501,3 +501,17 @@ def test_errors_in_a_script_point_at_its_line_with_its_own_traceback(cell: Stati
     assert "olp" not in error.hint.replace("prog.py", "")
     own = failure(cell, "x = {}\nx['missing']\n")
     assert own.span.line == 7 and own.message == "KeyError: 'missing'"
+
+
+def test_help_of_olp_dsl_lists_every_robot_method() -> None:
+    """Issue 16: ``help(olp.dsl)`` did not list the robot's methods."""
+    import pydoc
+
+    from olp import dsl
+
+    text = pydoc.render_doc(dsl, renderer=pydoc.plaintext)
+    for cls in (dsl.Robot, dsl.Mat, dsl.Target):
+        assert f"class {cls.__name__}" in text
+        public = [n for n in vars(cls) if not n.startswith("_") and callable(getattr(cls, n))]
+        missing = [n for n in public if f"{n}(self" not in text and f"{n} = " not in text]
+        assert not missing, (cls.__name__, missing)
