@@ -649,6 +649,16 @@ class Item:
         variants = variants[np.all(np.isfinite(variants), axis=-1)]
         return Mat(np.degrees(variants).T) if len(variants) else Mat(0, 0)
 
+    def JointPoses(self, joints: Any = None) -> list[Mat]:
+        """The poses of the robot's links (mm) relative to its base for ``joints`` (degrees;
+        default: the simulated joints): index 0 is the base, then one per joint."""
+        self._n("JointPoses", ITEM_TYPE_ROBOT)
+        tree = _tree()
+        degrees = tree.recorder.Joints() if joints is None else _degrees(joints, "JointPoses")
+        robot = tree.station.robot
+        poses = robot.link_poses(np.radians(degrees))
+        return [_mm(inv(robot.base) @ pose) for pose in poses.values()]
+
     def JointsConfig(self, joints: Any) -> Mat:
         """RoboDK's configuration flags ``[REAR, LOWERARM, FLIP, 0]`` (1/0) for joints (deg):
         the shoulder behind axis 1, the elbow down, axis 5 negative (olp's OPW flags)."""
