@@ -717,7 +717,8 @@ class Robot:
 
     # ---- tool and frame
     def setPoseTool(self, tool: Any) -> Robot:
-        """The active tool: a station tool name, a :class:`ToolItem` or a TCP pose (mm)."""
+        """The active tool: a station tool name or number, a :class:`ToolItem` or a TCP pose
+        (mm; it gets the next free tool number)."""
         self._tool = self._tool_of(tool)
         return self
 
@@ -751,10 +752,24 @@ class Robot:
             return tool.tool
         if isinstance(tool, str):
             return self._station_item(tool, "tool")
+        if isinstance(tool, int | np.integer) and not isinstance(tool, bool):
+            return self._tool_number(int(tool))
         line = self._s.span().line
         name = f"tool_l{line}"
         pose = self._rigid(tool, "setPoseTool")
         return ir.Tool(name=name, pose=pose, number=self._s.tool_number(name))
+
+    def _tool_number(self, number: int) -> ir.Tool:
+        """The station's tool with controller number ``number`` (0: the flange)."""
+        station = self._s.station
+        tools = list(station.tools.values()) if station is not None else []
+        for tool in tools:
+            if tool.number == number:
+                return tool
+        if number == 0:
+            return ir.FLANGE
+        known = ", ".join(f"{t.number} {t.name}" for t in tools if t.number is not None)
+        raise DslError(f"setPoseTool: no tool number {number} (tools: {known or 'none'})")
 
     def _frame_of(self, frame: Any) -> ir.Frame:
         if isinstance(frame, FrameItem):

@@ -108,3 +108,12 @@ def test_a_script_builds_through_olp_build(tmp_path: Path) -> None:
     assert code == 0
     text = "".join(p.read_text() for p in sorted(tmp_path.iterdir()))
     assert "ARCSTART" in text.upper() and "UTOOL_NUM=1" in text.replace(" ", "")
+
+
+def test_tools_a_script_adds_get_fanuc_tool_numbers() -> None:
+    """The probe tool_change.py adds is numbered after the station's three tools: UT 4."""
+    path = EXAMPLES / "tool_change.py"
+    cell = _station("robodk_kr6_cell")
+    result = olp.build(cell, run_dsl(path.read_bytes(), str(path), cell).program, post="fanuc")
+    text = "".join(result.files.values()).replace(" ", "")
+    assert result.ok and "UTOOL_NUM=4" in text and "UTOOL_NUM=2" in text
