@@ -329,7 +329,9 @@ def test_move_tests_return_robodk_codes_and_place_the_robot(cell: Station) -> No
 def test_solve_fk_ik_joints_config(cell: Station) -> None:
     """SolveFK(joints, tool, reference): the flange "with respect to the robot base reference";
     SolveIK(pose, joints_approx, tool, reference) returns a Mat of joints, an empty Mat when
-    there is no solution; JointsConfig: "[REAR, LOWERARM, FLIP, turns]"."""
+    there is no solution; SolveIK_All: "a 2D matrix [N x M], where N is the number of degrees
+    of freedom (robot joints) and M is the number of solutions"; JointsConfig: "[REAR,
+    LOWERARM, FLIP, turns]"."""
     body = (
         "robot = RDK.Item('', ITEM_TYPE_ROBOT)\n"
         "j = [10, -80, 100, 20, 40, -30]\n"
@@ -344,7 +346,9 @@ def test_solve_fk_ik_joints_config(cell: Station) -> None:
         "lower, upper, kind = robot.JointLimits()\n"
         "assert near([lower.list()[2], upper.list()[2], kind], [-120, 156, 0])\n"
         "assert len(robot.JointPoses(j)) == 7 and robot.JointPoses(j)[0].Pos() == [0, 0, 0]\n"
-        "assert len(robot.SolveIK_All(pose).list2()) == 6\n"
+        "sols = robot.SolveIK_All(pose)\n"
+        "assert sols.size(0) == 6 and len(sols) >= 4\n"
+        "assert all(near(robot.SolveFK(s).Pos(), pose.Pos()) for s in sols)\n"
         "robot.Pause(1)\n"
     )
     run(cell, body)

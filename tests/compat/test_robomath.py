@@ -104,15 +104,19 @@ def test_abb_quaternion_w_first_and_ur_rotation_vector_in_mm(angles: list[float]
 
 def test_mat_shapes_as_robodk() -> None:
     """robomath.Mat: Mat() is 4x4 zeros; a flat list becomes a column (how joints come back);
-    list()/tolist() give the column; rows with .rows; size() is (rows, cols)."""
+    list()/tolist(): "Returns the first column of the matrix as a list"; list2(): "one list
+    per column"; len(): "Return the number of columns"; iterating gives the columns."""
     assert rm.Mat().size() == (4, 4) and not np.any(_m(rm.Mat()))
     joints = rm.Mat([10, 20, 30, 40, 50, 60])
     assert joints.size() == (6, 1) and joints.size(0) == 6
     assert joints.list() == joints.tolist() == [10, 20, 30, 40, 50, 60]
-    assert list(joints) == [10, 20, 30, 40, 50, 60] and len(joints) == 6
-    assert joints.tr().size() == (1, 6) and joints.tr().list() == [10, 20, 30, 40, 50, 60]
+    assert len(joints) == 1 and list(joints) == [[10, 20, 30, 40, 50, 60]]
+    assert joints.tr().size() == (1, 6) and joints.tr().list() == [10]
     assert rm.Mat(2, 3).size() == (2, 3)
-    assert rm.Mat([[1, 2], [3, 4]]).rows == [[1, 2], [3, 4]]
+    table = rm.Mat([[1, 2], [3, 4]])
+    assert table.rows == [[1, 2], [3, 4]] and table.list2() == [[1, 3], [2, 4]]
+    assert list(table) == [[1, 3], [2, 4]] and table[1, 0] == 3 and table[0].list() == [1, 2]
+    assert rm.transl(1, 2, 3) == rm.transl(1, 2, 3 + 1e-9)
 
 
 def test_pose_methods() -> None:

@@ -34,7 +34,7 @@ from olp.vendors import abb, fanuc, kuka, ur
 
 FloatArray = NDArray[np.float64]
 Numbers = list[float]
-Rows = list[list[float]]
+RowList = list[list[float]]
 
 pi = math.pi
 sin, cos, tan, sqrt = math.sin, math.cos, math.tan, math.sqrt
@@ -71,7 +71,7 @@ class Mat:
 
     # ---- RoboDK's attributes and sizes
     @property
-    def rows(self) -> Rows:
+    def rows(self) -> RowList:
         """The rows as lists (RoboDK's ``Mat.rows``)."""
         rows: list[list[float]] = self._m.tolist()
         return rows
@@ -82,40 +82,71 @@ class Mat:
         return shape if dim is None else shape[dim]
 
     def __len__(self) -> int:
-        return int(self._m.shape[0])
+        """The number of **columns** (RoboDK's ``Mat.__len__``)."""
+        return int(self._m.shape[1])
 
-    def __iter__(self) -> Iterator[Any]:
-        """Iterating a column yields numbers, a matrix its rows (as RoboDK's Mat)."""
-        if self._m.shape[1] == 1:
-            return iter(self._m[:, 0].tolist())
-        return iter(self._m.tolist())
+    def __iter__(self) -> Iterator[Numbers]:
+        """The **columns**, each a list (RoboDK's ``Mat.__iter__``): a joint column gives one
+        list; the dof x M answer of ``SolveIK_All`` gives one list per solution."""
+        return iter(self._m.T.tolist())
 
     def __getitem__(self, index: Any) -> Any:
+        """``m[i, j]`` a number; ``m[i]`` row i as a column Mat; slices a Mat (as RoboDK)."""
+        if isinstance(index, int | np.integer):
+            return Mat(self._m[int(index)].tolist())
         value = self._m[index]
-        return float(value) if np.ndim(value) == 0 else value
+        return float(value) if np.ndim(value) == 0 else Mat(np.atleast_2d(value))
 
     def __setitem__(self, index: Any, value: Any) -> None:
-        self._m[index] = value
+        self._m[index] = value._m if isinstance(value, Mat) else value
+
+    def Rows(self) -> RowList:
+        """The rows as lists."""
+        return self.rows
+
+    def Cols(self) -> RowList:
+        """The columns as lists."""
+        rows: RowList = self._m.T.tolist()
+        return rows
+
+    def Row(self, n: int) -> Numbers:
+        row: Numbers = self._m[n].tolist()
+        return row
+
+    def Col(self, n: int) -> Numbers:
+        col: Numbers = self._m[:, n].tolist()
+        return col
+
+    def RowsCount(self) -> int:
+        return int(self._m.shape[0])
+
+    def ColsCount(self) -> int:
+        return int(self._m.shape[1])
 
     def __array__(self, dtype: Any = None, copy: Any = None) -> FloatArray:
         return np.array(self._m, dtype=dtype)
 
     def __eq__(self, other: object) -> bool:
+        """Equal sizes and values within 1e-6 (RoboDK compares with ``pose_is_similar``)."""
         if not isinstance(other, Mat):
             return NotImplemented
-        return self._m.shape == other._m.shape and bool(np.array_equal(self._m, other._m))
+        same = self._m.shape == other._m.shape
+        return same and bool(np.allclose(self._m, other._m, rtol=0.0, atol=1e-6))
 
     __hash__ = None  # type: ignore[assignment]
 
     def __str__(self) -> str:
-        return "\n".join(" ".join(f"{v:.3f}" for v in row) for row in self._m)
-
-    def __repr__(self) -> str:
-        if self._m.shape == (4, 4):
+        """RoboDK's layout: ``Pose(x, y, z,  rx, ry, rz):`` (mm, deg) for a pose, then rows."""
+        head = ""
+        if self.isHomogeneous():
             x, y, z, rx, ry, rz = Pose_2_TxyzRxyz(self)
             r = 180 / pi
-            return f"Pose({x:.3f}, {y:.3f}, {z:.3f}, {rx * r:.3f}, {ry * r:.3f}, {rz * r:.3f})"
-        return f"Mat({self._m.tolist()!r})"
+            head = f"Pose({x:.3f}, {y:.3f}, {z:.3f},  {rx * r:.3f}, {ry * r:.3f}, {rz * r:.3f}):\n"
+        rows = "\n [ ".join(", ".join(f"{v:.3f}" for v in row) + " ]," for row in self._m)
+        return f"{head}[[ {rows[:-1]}]\n"
+
+    def __repr__(self) -> str:
+        return f"Matrix: {self.size()}\n{self}"
 
     # ---- arithmetic
     def __mul__(self, other: Any) -> Any:
@@ -150,16 +181,15 @@ class Mat:
 
     # ---- lists
     def list(self) -> Numbers:
-        """The first column as a list (the joints of a joint Mat); a one-row Mat's row."""
-        if self._m.shape[0] == 1:
-            return self._m[0].tolist()
-        return self._m[:, 0].tolist() if self._m.size else []
+        """The first column as a list (the joints of a joint Mat); [] for an empty Mat."""
+        column: Numbers = self._m[:, 0].tolist() if self._m.size else []
+        return column
 
     tolist = list
 
-    def list2(self) -> Rows:
-        """The rows as lists."""
-        return self.rows
+    def list2(self) -> RowList:
+        """The columns as lists (RoboDK: "one list per column")."""
+        return self.Cols()
 
     def tr(self) -> Mat:
         """The transpose."""
@@ -216,28 +246,31 @@ class Mat:
         return self
 
     def inv(self) -> Mat:
-        """The inverse: of a rigid transform if it is one, else the matrix inverse."""
-        if self._m.shape == (4, 4) and self.isHomogeneous():
-            return self.invH()
-        return Mat(np.linalg.inv(self._m))
+        """The inverse of a rigid transform (RoboDK: the same as :meth:`invH`)."""
+        return self.invH()
 
     def invH(self) -> Mat:
-        """The inverse of a rigid transform."""
+        """The inverse of a rigid transform; a MatrixError for any other matrix."""
         m = self._pose("invH")
+        if not self.isHomogeneous():
+            raise MatrixError("invH: the pose is not homogeneous (a rigid transform)")
         out = np.eye(4)
         out[:3, :3] = m[:3, :3].T
         out[:3, 3] = -m[:3, :3].T @ m[:3, 3]
         return Mat(out)
 
     def isHomogeneous(self) -> bool:
-        """True for a rigid transform (orthonormal rotation, last row 0 0 0 1)."""
+        """True for a 4 x 4 rigid transform: RoboDK's test (the entries of ``R·Rᵀ - I`` sum to
+        at most 1e-4 in absolute value), plus a last row 0 0 0 1 and no mirror (olp's IR
+        checks rigidity again, with its own tolerance)."""
         m = self._m
         if m.shape != (4, 4) or not np.all(np.isfinite(m)):
             return False
         if not np.allclose(m[3], [0.0, 0.0, 0.0, 1.0], atol=1e-9):
             return False
         rot = m[:3, :3]
-        return bool(np.allclose(rot @ rot.T, np.eye(3), atol=1e-6) and np.linalg.det(rot) > 0)
+        deviation = float(np.sum(np.abs(rot @ rot.T - np.eye(3))))
+        return deviation <= 1e-4 and float(np.linalg.det(rot)) > 0
 
     def translationPose(self) -> Mat:
         """The translation part as a pose."""
