@@ -9,6 +9,11 @@ calling process, for the child and for callers who already trust the text. Each 
 ``robot`` records one IR instruction whose span is the user's call (file, line and column of
 the innermost frame in the program file), so every later diagnostic points at the user's line.
 
+While the program runs, RoboDK's module names (``robolink``, ``robodk``, ``robodk.robolink``,
+``robodk.robomath`` ...) import olp's answers to them (:mod:`olp.compat`), so a RoboDK script
+runs unchanged; after the run they are gone. A script that fills RoboDK program items builds
+that program (:meth:`Session.built`).
+
 Parameters come from the command line (``--set SPEED=50``) and are read with
 ``param("SPEED", default)``: text is converted to the type of the default (bool, int, float or
 text; without a default an int, else a float, else the text). A ``--set`` name the program
