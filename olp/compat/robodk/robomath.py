@@ -617,6 +617,7 @@ def pause(seconds: float) -> None:
 
 _OWN = frozenset(
     {"annotations", "math", "np", "NDArray", "Any", "Iterator", "Sequence", "FloatArray"}
+    | {"Numbers", "RowList"}
     | {"abb", "fanuc", "kuka", "ur"}
 )
 __all__ = sorted(n for n in globals() if not n.startswith("_") and n not in _OWN)
