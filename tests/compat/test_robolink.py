@@ -414,16 +414,21 @@ def test_program_items_build_the_program(cell: Station) -> None:
 
 
 def test_instruction_access_and_editing(cell: Station) -> None:
-    """Instruction(ins_id): "(name, instype, movetype, isjointtarget, target, joints)";
+    """Instruction(ins_id): "(name, instype, movetype, isjointtarget, target, joints)", a move
+    with both its pose and its joints;
     setInstruction(ins_id, name, instype, movetype, isjointtarget, target, joints);
     InstructionDelete(ins_id) is True when it deleted; InstructionCount()."""
     body = PROGRAM + (
         "assert prog.InstructionCount() == 5\n"
         "name, kind, move, isjoint, pose, joints = prog.Instruction(0)\n"
-        "assert (kind, move, isjoint) == (INS_TYPE_MOVE, MOVE_TYPE_JOINT, 1) and pose is None\n"
+        "assert (kind, move, isjoint) == (INS_TYPE_MOVE, MOVE_TYPE_JOINT, 1)\n"
+        "assert near(robot.SolveFK(joints, robot.Childs()[0].PoseTool(),"
+        " RDK.Item('Table').PoseAbs()).Pos(), pose.Pos())\n"
         "assert near(joints.list(), [0, -90, 90, 0, 45, 0])\n"
         "name, kind, move, isjoint, pose, joints = prog.Instruction(2)\n"
         "assert (move, isjoint) == (MOVE_TYPE_LINEAR, 0) and near(pose.Pos(), [0, 0, 100])\n"
+        "assert near(robot.SolveIK(pose, joints, RDK.Item('Torch').PoseTool(),"
+        " RDK.Item('Table').PoseAbs()).list(), joints.list())\n"
         "assert prog.Instruction(3)[1] == INS_TYPE_PAUSE\n"
         "prog.setInstruction(2, name, kind, MOVE_TYPE_JOINT, 0, transl(0, 0, -2) * pose, None)\n"
         "assert prog.InstructionDelete(3) and not prog.InstructionDelete(10)\n"

@@ -1093,19 +1093,36 @@ def _test(rec: dsl.Robot, start: FloatArray, move: ir.Instruction) -> int:
 
 
 def _describe_instruction(instruction: ir.Instruction) -> tuple[str, int, Any, Any, Any, Any]:
+    """RoboDK's instruction tuple. A move gives both its target pose (the TCP in the move's
+    frame, mm) and its joints (degrees), as RoboDK does: the one the target does not hold is
+    computed (forward kinematics, or the IK solution nearest the simulated joints; None when
+    there is none)."""
+    name = _instruction_name(instruction)
     if isinstance(instruction, ir.CircularMove):
-        return _instruction_name(instruction), INS_TYPE_MOVEC, None, None, None, None
+        return name, INS_TYPE_MOVEC, None, None, None, None
     if not isinstance(instruction, ir.JointMove | ir.LinearMove):
         kinds = {ir.Wait: INS_TYPE_PAUSE, ir.Call: INS_TYPE_CODE, ir.Comment: INS_TYPE_CODE}
-        kind = kinds.get(type(instruction), INS_TYPE_CODE)
-        return _instruction_name(instruction), kind, None, None, None, None
+        return name, kinds.get(type(instruction), INS_TYPE_CODE), None, None, None, None
     move = MOVE_TYPE_JOINT if isinstance(instruction, ir.JointMove) else MOVE_TYPE_LINEAR
+    tree = _tree()
+    station = tree.station
+    tool = instruction.tool if instruction.tool.pose is not None else station.tool(instruction.tool)
+    frame = (
+        instruction.frame
+        if instruction.frame.pose is not None
+        else station.frame(instruction.frame)
+    )
+    tool_pose = np.eye(4) if tool is None or tool.pose is None else tool.pose
+    frame_pose = np.eye(4) if frame is None or frame.pose is None else frame.pose
     target = instruction.target
     if isinstance(target, ir.JointTarget):
-        joints = _column(target.joints)
-        return _instruction_name(instruction), INS_TYPE_MOVE, move, 1, None, joints
+        tcp = inv(frame_pose) @ station.robot.flange_poses(target.joints) @ tool_pose
+        return name, INS_TYPE_MOVE, move, 1, _mm(tcp), _column(target.joints)
     assert isinstance(target, ir.CartesianTarget)
-    return _instruction_name(instruction), INS_TYPE_MOVE, move, 0, _mm(target.pose), None
+    flange = frame_pose @ target.pose @ inv(tool_pose)
+    found = dsl._nearest_solution(station, flange, np.radians(tree.recorder.Joints()))
+    joints = None if found is None else _column(found)
+    return name, INS_TYPE_MOVE, move, 0, _mm(target.pose), joints
 
 
 def _instruction_name(instruction: ir.Instruction) -> str:
