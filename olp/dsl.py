@@ -754,9 +754,11 @@ class Robot:
             return self._station_item(tool, "tool")
         if isinstance(tool, int | np.integer) and not isinstance(tool, bool):
             return self._tool_number(int(tool))
-        line = self._s.span().line
-        name = f"tool_l{line}"
         pose = self._rigid(tool, "setPoseTool")
+        known = self._same_pose(pose, [self._tool, *self._station_tools(), ir.FLANGE])
+        if known is not None:
+            return known
+        name = f"tool_l{self._s.span().line}"
         return ir.Tool(name=name, pose=pose, number=self._s.tool_number(name))
 
     def _tool_number(self, number: int) -> ir.Tool:
@@ -776,8 +778,25 @@ class Robot:
             return frame.frame
         if isinstance(frame, str):
             return self._station_item(frame, "frame")
-        line = self._s.span().line
-        return ir.Frame(name=f"frame_l{line}", pose=self._rigid(frame, "setPoseFrame"))
+        pose = self._rigid(frame, "setPoseFrame")
+        frames = self._s.station.frames.values() if self._s.station is not None else ()
+        known = self._same_pose(pose, [self._frame, *frames, ir.WORLD])
+        if known is not None:
+            return known
+        return ir.Frame(name=f"frame_l{self._s.span().line}", pose=pose)
+
+    def _station_tools(self) -> list[ir.Tool]:
+        return list(self._s.station.tools.values()) if self._s.station is not None else []
+
+    @staticmethod
+    def _same_pose(pose: FloatArray, items: Sequence[Any]) -> Any:
+        """The first of ``items`` (tools or frames) whose pose is ``pose`` (to 1 µm and 1 µrad):
+        a pose read back from a tool or frame (``robot.setPoseTool(robot.PoseTool())``) keeps
+        that tool or frame, and with it its controller number."""
+        for item in items:
+            if item.pose is not None and np.allclose(item.pose, pose, rtol=0.0, atol=1e-6):
+                return item
+        return None
 
     def _station_item(self, name: str, kind: str) -> Any:
         builtin: Mapping[str, Any] = (

@@ -524,3 +524,43 @@ def test_help_of_olp_dsl_lists_every_robot_method() -> None:
         public = [n for n in vars(cls) if not n.startswith("_") and callable(getattr(cls, n))]
         missing = [n for n in public if f"{n}(self" not in text and f"{n} = " not in text]
         assert not missing, (cls.__name__, missing)
+
+
+def test_a_pose_read_back_keeps_its_tool_and_frame(cell: Station) -> None:
+    """``program.setPoseTool(robot.PoseTool())`` (RoboDK's CSV example) keeps the station's
+    tool, and with it its controller number, instead of defining a new one; likewise frames;
+    ``robot.getLink(ITEM_TYPE_FRAME)`` is the robot's active frame (its base frame at first)."""
+    body = (
+        "robot = RDK.Item('', ITEM_TYPE_ROBOT)\n"
+        "robot.setPoseTool(RDK.Item('Pen'))\n"
+        "frame = robot.getLink(ITEM_TYPE_FRAME)\n"
+        "assert frame.Name() == 'KUKA KR 6 R900 sixx Base', frame\n"
+        "assert robot.getLink(ITEM_TYPE_TOOL).Name() == 'Pen'\n"
+        "prog = RDK.AddProgram('P', robot)\n"
+        "prog.setPoseTool(robot.PoseTool())\n"
+        "prog.setPoseFrame(RDK.Item('Table').Pose())\n"
+        "prog.MoveJ(RDK.Item('Home'))\n"
+        "prog.setPoseTool(eye(4))\n"
+        "prog.MoveJ(RDK.Item('Home'))\n"
+    )
+    first, second = moves(run(cell, body))
+    assert first.tool is cell.tools["Pen"] and first.frame is cell.frames["Table"]
+    assert second.tool is ir.FLANGE
+
+
+def test_file_dialogs_take_the_file_from_the_command_line(cell: Station, tmp_path: Path) -> None:
+    """robodialogs.getOpenFileName opens a dialog in RoboDK; on olp ``--set OPEN_FILE=PATH``
+    answers it (noted), and without one it is an error naming the parameter."""
+    points = tmp_path / "points.csv"
+    points.write_text("1,2,3\n", encoding="utf-8")
+    body = (
+        "from robodk.robodialogs import getOpenFileName\n"
+        "from robodk.robofileio import LoadList\n"
+        "path = getOpenFileName(RDK.getParam('PATH_OPENSTATION'))\n"
+        "assert LoadList(path) == [[1.0, 2.0, 3.0]]\n"
+        "RDK.Item('', ITEM_TYPE_ROBOT).Pause(1)\n"
+    )
+    result = run(cell, body, OPEN_FILE=str(points))
+    assert [i.span.line for i in result.ignored] == [8]
+    error = failure(cell, body)
+    assert error.span.line == 8 and "--set OPEN_FILE=PATH" in error.message

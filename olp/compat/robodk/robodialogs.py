@@ -2,8 +2,9 @@
 
 Each dialog is a no-op noted in the build output and answers as a user who accepts the
 default would: ``mbox`` returns True (or ``entry``, its default text, when one is given);
-``ShowMessage`` returns None; the file dialogs return the ``strfile`` default, or raise when
-there is none (a script must not silently read nothing). Source for names and arguments: the
+``ShowMessage`` returns None; the file dialogs return the file named by ``--set OPEN_FILE=PATH``
+(``SAVE_FILE`` for a save dialog), else their ``strfile`` default, else raise (a script must
+not silently read nothing). Source for names and arguments: the
 RoboDK API for Python, ``robodk/robodialogs.py``.
 """
 
@@ -36,21 +37,29 @@ def ShowMessage(msg: str, title: str | None = None, *args: Any, **kwargs: Any) -
     note("ShowMessage", f"no pop-up offline; the message was {str(msg)[:80]!r}")
 
 
-def _file_default(call: str, strfile: str) -> str:
-    if not strfile:
-        from olp.dsl import DslError
+def _file_default(call: str, key: str, path_preference: str, strfile: str) -> str:
+    from olp import dsl
 
-        raise DslError(f"{call}: olp opens no file dialog; give the file name in the script")
-    note(call, f"no file dialog offline; using {strfile!r}")
-    return strfile
+    given = dsl.session().param(key, "")
+    chosen = str(given) if given else strfile
+    if not chosen:
+        raise dsl.DslError(f"{call}: olp opens no file dialog; give the file with --set {key}=PATH")
+    import os
+
+    if not os.path.isabs(chosen) and path_preference and not given:
+        chosen = os.path.join(path_preference, chosen)
+    note(call, f"no file dialog offline; using {chosen!r}")
+    return chosen
 
 
 def getOpenFileName(path_preference: str = "", strfile: str = "", *a: Any, **k: Any) -> str:
-    return _file_default("getOpenFileName", strfile)
+    """The file ``--set OPEN_FILE=PATH`` names, else ``strfile`` (in ``path_preference``)."""
+    return _file_default("getOpenFileName", "OPEN_FILE", path_preference, strfile)
 
 
 def getSaveFileName(path_preference: str = "", strfile: str = "", *a: Any, **k: Any) -> str:
-    return _file_default("getSaveFileName", strfile)
+    """The file ``--set SAVE_FILE=PATH`` names, else ``strfile`` (in ``path_preference``)."""
+    return _file_default("getSaveFileName", "SAVE_FILE", path_preference, strfile)
 
 
 getOpenFile = getOpenFileName

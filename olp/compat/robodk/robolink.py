@@ -453,9 +453,20 @@ class Item:
         return [self._wrap(c) for c in self._n("Childs").children if c.alive]
 
     def getLink(self, type_linked: int = ITEM_TYPE_ROBOT) -> Item:
-        """The robot a program, target or tool belongs to (olp stations have one robot)."""
-        self._n("getLink")
-        return self._wrap(_tree().robot if type_linked == ITEM_TYPE_ROBOT else None)
+        """The robot a program, target or tool belongs to (olp stations have one robot); of a
+        robot or program, ``ITEM_TYPE_FRAME`` / ``ITEM_TYPE_TOOL``: its active frame or tool
+        (the robot base frame while the active frame is where the base is)."""
+        node = self._n("getLink")
+        tree = _tree()
+        if type_linked == ITEM_TYPE_ROBOT:
+            return self._wrap(tree.robot)
+        if node.recorder is None or type_linked not in (ITEM_TYPE_FRAME, ITEM_TYPE_TOOL):
+            return self._wrap(None)
+        if type_linked == ITEM_TYPE_TOOL:
+            name = node.recorder._tool.name
+            tools = [n for n in tree.robot.children if n.alive and n.name == name]
+            return self._wrap(tools[0] if tools else None)
+        return self._wrap(_frame_node(tree, node.recorder._frame))
 
     def setRobot(self, robot: Item | None = None) -> Item:
         """Programs and targets belong to the station's only robot: accepted as it is."""
@@ -1034,6 +1045,20 @@ def _recorder(node: _Node) -> dsl.Robot:
     recorder = node.recorder
     assert recorder is not None
     return recorder
+
+
+def _frame_node(tree: _Tree, frame: ir.Frame) -> _Node | None:
+    """The tree's frame item for an IR frame: by name, else the robot base frame or the
+    station when the pose is theirs."""
+    frames = [n for n in tree.nodes() if n.kind == ITEM_TYPE_FRAME]
+    for node in frames:
+        if node.name == frame.name:
+            return node
+    pose = np.eye(4) if frame.pose is None else frame.pose
+    base = tree.robot.parent
+    if base is not None and np.allclose(base.world(), pose, rtol=0.0, atol=1e-9):
+        return base
+    return tree.root if np.allclose(pose, np.eye(4), rtol=0.0, atol=1e-9) else None
 
 
 def _reference(pose: Any) -> FloatArray:
