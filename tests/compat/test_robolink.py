@@ -564,3 +564,20 @@ def test_file_dialogs_take_the_file_from_the_command_line(cell: Station, tmp_pat
     assert [i.span.line for i in result.ignored] == [8]
     error = failure(cell, body)
     assert error.span.line == 8 and "--set OPEN_FILE=PATH" in error.message
+
+
+def test_instruction_select_inserts_after_the_selected_instruction(cell: Station) -> None:
+    """InstructionSelect(ins_id): "New instructions will be added after the selected
+    instruction" (RoboDK's PrintProgramInstructions example adds a call after each one)."""
+    body = PROGRAM + (
+        "prog.InstructionSelect(1)\n"
+        "prog.RunInstruction('AfterApproach')\n"
+        "prog.RunInstruction('Second')\n"
+        "assert prog.InstructionSelect() == 3\n"
+        "prog.InstructionDelete(0)\n"
+        "prog.RunInstruction('Third')\n"
+    )
+    kinds = [getattr(i, "name", i.kind) for i in run(cell, body).program.instructions]
+    assert kinds == ["joint", "AfterApproach", "Second", "Third", "linear", "wait", "joint"]
+    error = failure(cell, PROGRAM + "prog.setParam(0)\n")
+    assert error.span.line == 15 and "Instruction/setInstruction" in error.message

@@ -499,8 +499,13 @@ class Item:
 
     Recolor = setColor
 
-    def setParam(self, param: str, value: Any = "", *args: Any, **kwargs: Any) -> str:
-        self._n("setParam")
+    def setParam(self, param: Any, value: Any = "", *args: Any, **kwargs: Any) -> str:
+        node = self._n("setParam")
+        if node.kind == ITEM_TYPE_PROGRAM and isinstance(param, int):
+            raise dsl.DslError(
+                "setParam(ins_id): instruction data as a dict is not supported by olp; read and "
+                "edit moves with Instruction/setInstruction, delete with InstructionDelete"
+            )
         note("setParam", f"RoboDK item parameter {str(param)[:40]!r} has no meaning in olp; no-op")
         return ""
 
@@ -932,8 +937,14 @@ class Item:
         return True
 
     def InstructionSelect(self, ins_id: int = -1) -> int:
-        self._program("InstructionSelect")
-        note("InstructionSelect", "olp appends new instructions at the end; no-op")
+        """Select instruction ``ins_id``: "New instructions will be added after the selected
+        instruction"; -1 returns the selected one (the last when none was selected)."""
+        node = self._program("InstructionSelect")
+        sink = node.record.instructions
+        assert isinstance(sink, _InsertingList)
+        if ins_id == -1:
+            return len(sink) - 1 if sink.cursor is None else sink.cursor - 1
+        sink.cursor = self._index("InstructionSelect", ins_id) + 1
         return ins_id
 
     def InstructionList(self) -> tuple[Mat, int]:
@@ -1039,6 +1050,25 @@ class Item:
 
 # ------------------------------------------------------------------------------------------------
 # Helpers of the items
+
+
+class _InsertingList(list[ir.Instruction]):
+    """A program item's instructions: appended at the end, or after the instruction
+    ``InstructionSelect`` chose (``cursor``: where the next one goes)."""
+
+    cursor: int | None = None
+
+    def append(self, instruction: ir.Instruction) -> None:
+        if self.cursor is None:
+            super().append(instruction)
+            return
+        self.insert(self.cursor, instruction)
+        self.cursor += 1
+
+    def __delitem__(self, index: Any) -> None:
+        if self.cursor is not None and isinstance(index, int) and index < self.cursor:
+            self.cursor -= 1
+        super().__delitem__(index)
 
 
 def _recorder(node: _Node) -> dsl.Robot:
@@ -1275,7 +1305,7 @@ class Robolink:
         from olp.frontends.dsl import ProgramRecord
 
         tree = self._tree
-        record = ProgramRecord(str(name), [])
+        record = ProgramRecord(str(name), _InsertingList())
         tree.session.programs.append(record)
         node = _Node(ITEM_TYPE_PROGRAM, str(name), tree.root)
         node.record = record
