@@ -21,6 +21,10 @@ the confidence given:
   1000]``) and zonedata ``z0 .. z200`` (:data:`PREDEFINED_ZONES`): medium-high confidence.
 * Moves: ``MoveAbsJ jointtarget\\NoEOffs, speed, zone, tool;`` for joint targets, ``MoveJ`` /
   ``MoveL`` / ``MoveC via, to`` with robtargets and ``\\WObj:=`` (left out for ``wobj0``).
+  ``MoveC`` interpolates the tool orientation from the start to the ``ToPoint`` and does not
+  reach the ``CirPoint``'s (RAPID reference, ``MoveC``, as remembered: medium confidence, not
+  found in a stored source): only :attr:`~olp.ir.ArcOrientation.INTERPOLATE` is written, no
+  circular angle (the base post's ``arc_orientation`` / ``arc_angle`` errors).
   ``ConfJ \\On`` / ``ConfL \\On`` make the controller take the written confdata. Joint moves are
   limited by the speeddata's TCP speed: RAPID has no joint speed fraction (warned).
 * ``SetDO signal, 0|1;``, ``WaitDI signal, 0|1;`` (I/O by configured signal name:

@@ -46,6 +46,7 @@ from numpy.typing import NDArray
 
 from olp.diagnostics import Diagnostic
 from olp.errors import PostError
+from olp.ir import ArcOrientation
 from olp.posts.numbers import NumberError, NumberFormat, format_number, format_numbers
 from olp.posts.sandbox import PostSandbox, make_environment
 from olp.posts.text import (
@@ -132,6 +133,12 @@ class Post:
     """The controller's own name for its reference frame."""
     PREDEFINED_NAMES: ClassVar[frozenset[str]] = frozenset()
     """Names the controller defines: generated data never take them."""
+    ARC_ORIENTATIONS: ClassVar[frozenset[ArcOrientation]] = frozenset({ArcOrientation.INTERPOLATE})
+    """The orientation rules of circular moves this language can write (the three-point arc
+    interpolating start to end, unless a brand says otherwise); any other is an error on the
+    move's line, never a different path."""
+    ARC_ANGLE: ClassVar[bool] = False
+    """Whether a circular move's circular angle (KUKA's CA) can be written."""
 
     def __init__(self, manifest: PostManifest) -> None:
         self.manifest = manifest
@@ -183,6 +190,7 @@ class Post:
     def check(self, compiled: CompiledProgram) -> list[Diagnostic]:
         """Everything this post reports about ``compiled``; errors mean nothing is written."""
         out = self._foreign_robot(compiled)
+        compiled = compiled.flat()
         for step in compiled.steps:
             out += self._shared_checks(step)
             out += self.check_instruction(step, compiled)
@@ -194,7 +202,8 @@ class Post:
         it is), so the text never depends on whether the caller prepared the program."""
         from olp.posts.render import render
 
-        return render(self.prepare(compiled)[0], self, name)
+        # The templates walk the steps row by row several times: make a toolpath's rows once.
+        return render(self.prepare(compiled)[0].flat(), self, name)
 
     def write(self, files: Mapping[str, str], folder: Path) -> list[Path]:
         """Encode every file in the manifest's encoding (a character it lacks is a PostError
@@ -292,7 +301,29 @@ class Post:
             return self._call_checks(step, ins.name, ins.args)
         if kind in ("set_output", "wait_input"):
             return self._io_checks(step, kind, ins.index)
+        if kind == "circular":
+            return self._arc_checks(step, ins)
         return []
+
+    def _arc_checks(self, step: Step, ins: Any) -> list[Diagnostic]:
+        """A circular move whose orientation rule or circular angle this language cannot
+        write (:attr:`ARC_ORIENTATIONS`, :attr:`ARC_ANGLE`)."""
+        out = []
+        if ins.orientation not in self.ARC_ORIENTATIONS:
+            can = ", ".join(sorted(o.value for o in self.ARC_ORIENTATIONS))
+            msg = (
+                f"the {self.LANGUAGE} post cannot write a circular move whose orientation rule is "
+                f"{ins.orientation.value!r} (it writes: {can})"
+            )
+            out.append(_error("arc_orientation", msg, step))
+        if ins.angle is not None and not self.ARC_ANGLE:
+            msg = (
+                f"the {self.LANGUAGE} post cannot write a circular angle (CA): the arc would "
+                "end at its programmed end point instead"
+            )
+            hint = "program the arc's real end point (and a second arc beyond 180°) instead"
+            out.append(_error("arc_angle", msg, step, hint=hint))
+        return out
 
     def _comment_checks(self, step: Step, text: str) -> list[Diagnostic]:
         try:

@@ -42,6 +42,11 @@ endings (the files are DOS text; medium confidence that LF would also do).
     controller's ``UTOOL[n]`` must hold; two such tools, or one whose default number another
     tool of the program has, are an error.
 
+* Arcs: ``C P[via]`` / ``P[end]`` only, with the orientation rule
+  :attr:`~olp.ir.ArcOrientation.INTERPOLATE` (start to end; low confidence: Fanuc's handling
+  of the via point's orientation on ``C`` is not verified from a stored source) and no
+  circular angle. Fanuc's ``A`` (circular arc through consecutive points) is not written: its
+  rules could not be verified.
 * Positions (:func:`ls_moves`): ``P[n]`` numbered in order of use in each file (a circle's via
   point before its end). A Cartesian target of an OPW arm is written as ``X, Y, Z`` (mm),
   ``W, P, R`` (deg) and the ``CONFIG`` of the planned joints (:func:`config_from_joints`), but

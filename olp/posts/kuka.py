@@ -16,8 +16,13 @@ files ``tests/golden/kuka/``.
 * Targets: ``E6POS`` ``{X,Y,Z,A,B,C,S,T}`` (mm, deg, S and T decimal as the pendant writes them
   in .dat files) for Cartesian targets, ``E6AXIS`` ``{A1..A6}`` (deg) for joint targets; inline
   aggregates or named points ``DECL E6POS XP1={..}`` in the .dat (the pendant's naming);
-  ``CIRC aux, end``. External axes E1..E6 are not written: on a robot without them they mean
-  nothing, and a written 0 would move an axis that exists.
+  ``CIRC aux, end`` (``, CA angle`` in degrees when the move has a circular angle), with
+  ``$ORI_TYPE``/``$CIRC_TYPE`` written before an arc whose rule differs from the last written
+  (:data:`olp.vendors.kuka.ARC_TYPES`; the first arc always writes both) and ``$ORI_TYPE =
+  #VAR`` again before the next LIN (olp's LIN interpolates the orientation). KRL writes every
+  rule but the wrist one (:attr:`KukaPost.ARC_ORIENTATIONS`). External axes E1..E6 are not
+  written: on a robot without them they mean nothing, and a written 0 would move an axis that
+  exists.
 * ``$TOOL``/``$BASE``: ``{FRAME: ..}`` or ``TOOL_DATA[1..16]``/``BASE_DATA[1..32]`` (the arrays
   of ``$config.dat``); ``$NULLFRAME`` for no tool / the world. ``$BASE`` is relative to
   ``$WORLD``.
@@ -46,11 +51,11 @@ from numpy.typing import ArrayLike
 
 from olp.diagnostics import Diagnostic
 from olp.errors import PostError
-from olp.ir import CartesianTarget
+from olp.ir import ArcOrientation, CartesianTarget
 from olp.posts.base import Filter, Post
 from olp.posts.numbers import NumberFormat, Storage
 from olp.posts.text import IDENTIFIER, NUMBER, ArgumentRule, NameRule, double_quoted, one_of
-from olp.vendors.kuka import pose_to_frame, status_turn, turn_ambiguous
+from olp.vendors.kuka import ARC_TYPES, pose_to_frame, status_turn, turn_ambiguous
 
 if TYPE_CHECKING:
     from olp.compiled import CompiledProgram, Step
@@ -189,6 +194,18 @@ def whole_percent(fraction: float) -> int:
     return math.floor(float(fraction) * 100.0 + 1e-9)
 
 
+def krl_arc_types(post: Post, step: PostStep) -> tuple[str, str]:
+    """``($ORI_TYPE, $CIRC_TYPE)`` without ``#`` of a circular move's orientation rule."""
+    ins: Any = step.instruction
+    return ARC_TYPES[ins.orientation]
+
+
+def krl_ca(post: Post, step: PostStep) -> str:
+    """``, CA 90.0000`` for a circular move with a circular angle (degrees), else ''."""
+    angle = getattr(step.instruction, "angle", None)
+    return "" if angle is None else f", CA {post.number('angle', math.degrees(angle))}"
+
+
 def _is_identity(pose: ArrayLike) -> bool:
     return bool(np.allclose(pose, np.eye(4), rtol=0.0, atol=1e-12))
 
@@ -215,6 +232,8 @@ FILTERS: Mapping[str, Filter] = {
     "krl_tool": krl_tool,
     "krl_base": krl_base,
     "krl_percent": krl_percent,
+    "krl_arc_types": krl_arc_types,
+    "krl_ca": krl_ca,
 }
 
 
@@ -232,6 +251,8 @@ class KukaPost(Post):
     )
     NUMBERS: ClassVar[Mapping[str, NumberFormat]] = NUMBERS
     FILTERS: ClassVar[Mapping[str, Filter]] = FILTERS
+    ARC_ORIENTATIONS = frozenset(ARC_TYPES) - {ArcOrientation.WRIST}
+    ARC_ANGLE = True
 
     def step_values(self, robot: Any, joints: Any) -> list[Mapping[str, Any]]:
         """Status and Turn of each motion's planned joints (N, 6) rad, and whether Turn cannot

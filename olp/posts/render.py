@@ -48,6 +48,7 @@ from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from olp import progress
 from olp.diagnostics import Diagnostic
 from olp.errors import PostError
 from olp.posts.text import basename
@@ -178,7 +179,9 @@ class _Renderer:
         ]
         allocation = self.view.allocate(names)
         if not split:
-            return self._files(self.manifest.files, self._unit(parts[0], allocation, 0, 0, entry))
+            out = self._files(self.manifest.files, self._unit(parts[0], allocation, 0, 0, entry))
+            progress.advance(len(parts[0]))
+            return out
         main = self._unit((), allocation, 0, len(parts), entry)
         main["parts"] = [
             {"name": n, "index": k + 1, "routine": r}
@@ -191,6 +194,7 @@ class _Renderer:
         for k, (steps, unit_name) in enumerate(zip(parts, unit_names, strict=True)):
             unit = self._unit(steps, allocation, k + 1, len(parts), routines[k], unit_name)
             files.update(self._files(self.manifest.files, unit, clash=files.keys() | main_files))
+            progress.advance(len(steps))
         return {**main_files, **files}
 
     def _unit(
