@@ -368,7 +368,7 @@ def test_speeds_and_rounding_units(cell: Station) -> None:
 
 def test_move_c_records_the_dsl_circular_move(cell: Station) -> None:
     """MoveC(target1, target2): "target1: pose along the circle movement, target2: final
-    circle target"; olp records the DSL's circular move (olp's checks report what they can)."""
+    circle target"; olp records the DSL's circular move, checked in simulate mode."""
     body = (
         "RDK.setRunMode(RUNMODE_MAKE_ROBOTPROG)\n"
         "robot = RDK.Item('', ITEM_TYPE_ROBOT)\n"
@@ -380,6 +380,21 @@ def test_move_c_records_the_dsl_circular_move(cell: Station) -> None:
     assert isinstance(move, ir.CircularMove)
     assert np.allclose(move.via.pose[:3, 3], [0.05, 0.05, 0.1])
     assert np.allclose(move.target.pose[:3, 3], [0.1, 0, 0.1])
+    simulated = (
+        "robot = RDK.Item('', ITEM_TYPE_ROBOT)\n"
+        "robot.setPoseFrame(RDK.Item('Table'))\n"
+        "robot.setTool(1)\n"
+        "t = RDK.Item('Target 1').Pose()\n"
+        "robot.MoveJ(transl(-50, 0, 0) * t)\n"
+        "robot.MoveC(transl(0, 50, 0) * t, transl(50, 0, 0) * t)\n"
+        "try:\n"
+        "    robot.MoveC(transl(0, 500, 0) * t, transl(3000, 0, 0) * t)\n"
+        "except TargetReachError:\n"
+        "    pass\n"
+    )
+    result = run(cell, simulated)
+    assert [m.kind for m in moves(result)] == ["joint", "circular"]
+    assert len(result.warnings) == 1 and result.warnings[0].span.line == 13
 
 
 # ------------------------------------------------------------------------------------------------

@@ -823,7 +823,8 @@ class Item:
         self._move(ir.LinearMove, target, "MoveL")
 
     def MoveC(self, target1: Any, target2: Any, blocking: bool = True) -> None:
-        """Circular move through ``target1`` to ``target2`` (the DSL's MoveC)."""
+        """Circular move through ``target1`` to ``target2`` (the DSL's MoveC; on the robot in
+        simulate mode, TargetReachError when olp's resolve pass finds it cannot run)."""
         node = self._n("MoveC", ITEM_TYPE_ROBOT, ITEM_TYPE_PROGRAM)
         rec = _recorder(node)
         via, via_frame = _ir_target(rec, target1, "MoveC")
