@@ -23,7 +23,12 @@ from olp.posts.view import build_steps
 
 REPO = Path(__file__).resolve().parents[2]
 CELL = REPO / "stations" / "kr6_milling_cell.yaml"
-ROW_POSTS = ["kuka"]  # posts with a row writer
+ROW_POSTS = ["kuka", "ur"]  # posts with a row writer
+PIECES = {
+    "kuka": ("$BASE = ", "$TOOL = ", "$VEL.ORI1", "$APO.CDIS", "C_DIS", "WAIT SEC", "; halfway"),
+    "ur": ("set_tcp(", "movel(", "r=0.001000", "v=0.03000", "sleep(", "# halfway"),
+}
+"""What the varied program must make each post write (the rows exercise those paths)."""
 
 
 def _moves(rows: int, tmp_path: Path) -> ir.Program:
@@ -80,8 +85,7 @@ def test_rows_are_written_as_the_templates_write_them(post: str, tmp_path: Path)
     assert rows.ok, [d.format() for d in rows.diagnostics]
     assert rows.files == template.files
     text = "".join(rows.files.values())
-    # the program does exercise what the writer writes
-    for piece in ("$BASE = ", "$TOOL = ", "$VEL.ORI1", "$APO.CDIS", "C_DIS", "WAIT SEC"):
+    for piece in PIECES[post]:
         assert piece in text
 
 
