@@ -23,10 +23,11 @@ from olp.posts.view import build_steps
 
 REPO = Path(__file__).resolve().parents[2]
 CELL = REPO / "stations" / "kr6_milling_cell.yaml"
-ROW_POSTS = ["kuka", "ur"]  # posts with a row writer
+ROW_POSTS = ["kuka", "ur", "abb"]  # posts with a row writer
 PIECES = {
     "kuka": ("$BASE = ", "$TOOL = ", "$VEL.ORI1", "$APO.CDIS", "C_DIS", "WAIT SEC", "; halfway"),
     "ur": ("set_tcp(", "movel(", "r=0.001000", "v=0.03000", "sleep(", "# halfway"),
+    "abb": ("LOCAL CONST robtarget", "MoveL ", "\\WObj:=", "_o45", "WaitTime", "! halfway"),
 }
 """What the varied program must make each post write (the rows exercise those paths)."""
 
