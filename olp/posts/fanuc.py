@@ -98,7 +98,7 @@ from olp.vendors.fanuc import (
 )
 
 if TYPE_CHECKING:
-    from olp.compiled import CompiledProgram
+    from olp.compiled import CompiledProgram, Step
     from olp.posts.view import PostStep
 
 FloatArray = NDArray[np.float64]
@@ -476,6 +476,25 @@ class FanucPost(Post):
     def __init__(self, manifest: Any) -> None:
         super().__init__(manifest)
         self._configs: dict[int, tuple[Any, dict[bytes, str | None]]] = {}
+
+    def check_instruction(self, step: Step, compiled: CompiledProgram) -> list[Diagnostic]:
+        """``speed_raised`` (warning): a speed LS cannot write so slow, written at its least
+        (``L``/``C`` 1mm/sec, ``J`` 1%): the robot moves faster there than programmed and
+        timed."""
+        ins: Any = step.instruction
+        if step.skipped or ins.kind not in ("joint", "linear", "circular"):
+            return []
+        if ins.kind == "joint":
+            given, least, unit = ins.speed.joint * 100.0, 1, "%"
+        else:
+            given, least, unit = ins.speed.linear * 1000.0, 1, "mm/sec"
+        if _round_half_up(given) >= least:
+            return []
+        message = (
+            f"speed {given:.3g} {unit} is below the least LS can write; written as "
+            f"{least}{unit}, faster than programmed"
+        )
+        return [Diagnostic("warning", "speed_raised", message, ins.span, step.index)]
 
     def step_values(self, robot: Any, joints: Any) -> list[Mapping[str, Any]]:
         """Per planned motion (joints (N, 6) rad) ``{"config": str | None}``, the CONFIG a

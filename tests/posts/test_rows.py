@@ -91,7 +91,7 @@ def test_rows_are_written_as_the_templates_write_them(post: str, tmp_path: Path)
         assert piece in text
 
 
-# Fanuc writes any L speed below 1 mm/sec as 1mm/sec (olp.posts.fanuc.linear_mm_per_s): no error.
+# Fanuc writes an L speed below 1 mm/sec as 1mm/sec with a warning (speed_raised), no error.
 @pytest.mark.parametrize("post", ["kuka", "ur", "abb"])
 def test_a_number_the_writer_cannot_write_is_an_error_on_its_row(post: str, tmp_path: Path) -> None:
     program = _moves(12, tmp_path)
