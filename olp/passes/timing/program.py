@@ -26,7 +26,7 @@ from olp.ir import is_motion
 from olp.passes.timing import ptp
 from olp.passes.timing.chains import PATH_SOLVERS, path_problem, time_law
 from olp.passes.timing.geometry import joined_geometry
-from olp.passes.timing.lines import line_profiles, straight_samples
+from olp.passes.timing.lines import LineProfiles, line_profiles, straight_samples
 from olp.passes.timing.plan import (
     MIN_PATH_SPEED,
     TimingError,
@@ -50,6 +50,7 @@ from olp.trajectory import LineLaws, Segment, TimeLaw
 
 if TYPE_CHECKING:
     from olp.passes.pipeline import BuildOptions
+    from olp.station.model import Robot
 
 
 FloatArray = NDArray[np.float64]
@@ -198,7 +199,7 @@ def time_lines(
     q0, q1 = table.q[table.lo[rows]], table.q[table.hi[rows]]
     robot = table.compiled.station.robot
     tools = table.tools[table.tool[rows]]
-    profiles = line_profiles(q0, q1, robot, tools, table.linear[rows], table.angular[rows])
+    profiles = _line_profiles(q0, q1, robot, tools, table.linear[rows], table.angular[rows])
     ok = profiles.excess <= options.line_tolerance
     rows = rows[ok]
     out.lines = LineLaws(
@@ -213,6 +214,42 @@ def time_lines(
     timed = np.zeros(straight.size, dtype=bool)
     timed[np.flatnonzero(straight)[ok]] = True
     return timed
+
+
+LINE_ROWS = 1 << 14
+"""Moves per batch of :func:`line_profiles` (five forward kinematics each: about 10 kB of
+temporaries per move, so a batch holds ~160 MB at most; all moves of a 100k toolpath at once
+took 330 MB)."""
+
+
+def _line_profiles(
+    q0: FloatArray,
+    q1: FloatArray,
+    robot: Robot,
+    tools: FloatArray,
+    linear: FloatArray,
+    angular: FloatArray,
+) -> LineProfiles:
+    """:func:`line_profiles` in batches of :data:`LINE_ROWS` moves."""
+    parts = [
+        line_profiles(
+            q0[lo : lo + LINE_ROWS],
+            q1[lo : lo + LINE_ROWS],
+            robot,
+            tools[lo : lo + LINE_ROWS],
+            linear[lo : lo + LINE_ROWS],
+            angular[lo : lo + LINE_ROWS],
+        )
+        for lo in range(0, len(q0), LINE_ROWS)
+    ]
+    if not parts:
+        return line_profiles(q0, q1, robot, tools, linear, angular)
+    return LineProfiles(
+        *(
+            np.concatenate([getattr(p, f) for p in parts])
+            for f in ("accel", "ramp", "duration", "excess")
+        )
+    )
 
 
 def time_chains(
