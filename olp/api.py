@@ -155,7 +155,7 @@ def build(
 
     with progress.stage("write", len(compiled.steps)):
         try:
-            files = writer.render(compiled, name)
+            files = writer.render(compiled, name, prepared=True)
         except RenderError as exc:
             return BuildResult(compiled, writer.name, diagnostics + exc.diagnostics)
         written: builtins.list[Path] = []

@@ -200,14 +200,19 @@ class Post:
             out += self.check_instruction(step, compiled)
         return out + self.check_program(compiled)
 
-    def render(self, compiled: CompiledProgram, name: str | None = None) -> dict[str, str]:
+    def render(
+        self, compiled: CompiledProgram, name: str | None = None, *, prepared: bool = False
+    ) -> dict[str, str]:
         """Every file of the program (:func:`olp.posts.render.render`), after the
         ``TRANSFORMS`` (which are idempotent: a program :meth:`prepare` already rewrote stays as
-        it is), so the text never depends on whether the caller prepared the program."""
+        it is), so the text never depends on whether the caller prepared the program.
+        ``prepared``: the caller has just applied :meth:`prepare` (skip doing it again)."""
         from olp.posts.render import render
 
+        if not prepared:
+            compiled = self.prepare(compiled)[0]
         # The templates walk the steps row by row several times: make a toolpath's rows once.
-        return render(self.prepare(compiled)[0].flat(), self, name)
+        return render(compiled.flat(), self, name)
 
     def write(self, files: Mapping[str, str], folder: Path) -> list[Path]:
         """Encode every file in the manifest's encoding (a character it lacks is a PostError
