@@ -386,7 +386,7 @@ def zone_stops(table: MotionTable, corners: Plan) -> list[Diagnostic]:
     found = []
     for i in np.flatnonzero(stops).tolist():
         msg = (
-            f"zone of {table.zone[i] * 1000:g} mm timed as an exact stop "
+            f"zone of {float(table.zone[i]) * 1000:g} mm timed as an exact stop "
             f"({_STOP_REASON[KIND_NAMES[int(table.kind[i])]]}): the cycle time is an upper "
             "bound here"
         )
