@@ -1,0 +1,182 @@
+"""olp over a folder of KRL programs, as a new user would run it: what builds and what stops why.
+
+Run from the repository root::
+
+    python -m benchmarks.krl_corpus [FOLDER] [--station S] [--config-dat P] [--post P] [-v]
+
+FOLDER defaults to olp's own corpus ``tests/corpus/krc`` (programs written for olp in the style
+of KR C4 controller backups); point it at a backup's ``KRC`` folder to measure real cells. The
+controller's ``$config.dat`` is found in FOLDER (any case; the first in sorted order) unless
+``--config-dat`` names one. Every ``.src`` (any case) is built with ``olp.build`` on the station
+(default: the bundled KR 6 milling cell) through the post (default ``kuka``), collisions off
+(they are a property of the cell, not of the program's syntax), nothing written.
+
+Each file lands in one class:
+
+* ``build``: no error diagnostic;
+* ``program``: stopped on program-level diagnostics only (unreachable, limits, ...);
+* ``syntax``: stopped on an :class:`olp.errors.OlpError` (olp cannot read or lower something),
+  counted by construct (the keyword at the error, or the block it sits in);
+* ``crash``: any other exception (a bug in olp).
+
+Besides, it counts statements olp read but did not put in the output and reported only at
+``info`` level (``silent_drops``: the issue's "nothing dropped silently" wants 0), and, for the
+files that build with the ``kuka`` post, the statements in and out (``statements_in`` /
+``statements_out``: non-comment, non-blank lines of the first routine and its callees vs. of the
+written program; a KRL -> KRL build should keep every one).
+
+The last lines are ``name: value unit``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+import re
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+CORPUS = REPO / "tests" / "corpus" / "krc"
+STATION = REPO / "stations" / "kr6_milling_cell.yaml"
+
+_KEYWORD_TEXT = (
+    "IF ELSE SWITCH CASE DEFAULT WHILE REPEAT UNTIL LOOP FOR GOTO EXIT HALT RETURN RESUME BRAKE "
+    "INTERRUPT TRIGGER DEFFCT DEF DECL STRUC ENUM SIGNAL EXT EXTFCT WAIT PTP LIN CIRC SPTP SLIN "
+    "SCIRC PTP_REL LIN_REL SPTP_REL SLIN_REL SCIRC_REL SPLINE ON_ERROR_PROCEED CONTINUE GLOBAL "
+    "CONST FRAME E6AXIS E6POS POS AXIS INT REAL BOOL CHAR"
+)
+_KEYWORDS = frozenset(_KEYWORD_TEXT.split())
+_INSIDE = re.compile(r"inside the (\w+) at line")
+_WORD = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]*")
+
+
+@dataclass
+class Tally:
+    """Counts over the corpus."""
+
+    classes: collections.Counter[str] = field(default_factory=collections.Counter)
+    constructs: collections.Counter[str] = field(default_factory=collections.Counter)
+    crashes: list[str] = field(default_factory=list)
+    silent_drops: int = 0
+    warned_drops: int = 0
+    statements_in: int = 0
+    statements_out: int = 0
+
+
+def construct_of(message: str, source_line: str | None) -> str:
+    """The construct an :class:`~olp.errors.OlpError` stopped on: the block a statement sits in,
+    else the first keyword of the offending line, else the message's first words."""
+    inside = _INSIDE.search(message)
+    if inside:
+        return inside.group(1).upper()
+    words = _WORD.findall(source_line or "")
+    for word in words[:3]:
+        if word.upper() in _KEYWORDS:
+            return word.upper()
+    if words and "=" in (source_line or ""):
+        return "assignment " + words[0].upper()
+    return "other: " + " ".join(message.split()[:5])
+
+
+def statement_lines(text: str) -> int:
+    """Lines that hold a statement: not blank, not only a comment, not a header or DEF/END."""
+    count = 0
+    for raw in text.splitlines():
+        line = raw.split(";", 1)[0].strip()
+        if not line or line.startswith("&"):
+            continue
+        if re.match(r"(?i)(GLOBAL\s+)?(DEF|DEFFCT|END|ENDFCT|DEFDAT|ENDDAT)\b", line):
+            continue
+        count += 1
+    return count
+
+
+def find_config(folder: Path) -> Path | None:
+    found = sorted(p for p in folder.rglob("*") if p.name.lower() == "$config.dat")
+    return found[0] if found else None
+
+
+def run(folder: Path, station_path: Path, config: Path | None, post: str, verbose: bool) -> Tally:
+    import olp
+    from olp.errors import OlpError
+    from olp.frontends.bundled import KrlOptions
+    from olp.frontends.krl import load_config_dat
+
+    station = olp.load_station(station_path)
+    config_data = None
+    if config is not None:
+        try:
+            config_data = load_config_dat(config)
+        except OlpError as exc:
+            print(f"config-dat unreadable, built without it: {exc.message}", file=sys.stderr)
+            print(f"  {exc.span}: {(exc.source_line or '').strip()[:80]}", file=sys.stderr)
+    options = KrlOptions(config_dat=config_data)
+    tally = Tally()
+    for path in sorted(p for p in folder.rglob("*") if p.suffix.lower() == ".src"):
+        verdict = _one(olp, path, station, options, post, tally, OlpError)
+        tally.classes[verdict.split(":")[0]] += 1
+        if verbose:
+            print(f"{path.relative_to(folder)}: {verdict}")
+    return tally
+
+
+def _one(olp, path, station, options, post, tally, olp_error) -> str:  # type: ignore[no-untyped-def]
+    try:
+        result = olp.build(station, path, post=post, program_options=options, collisions=None)
+    except olp_error as exc:
+        construct = construct_of(exc.message, exc.source_line)
+        tally.constructs[construct] += 1
+        return f"syntax: {construct} ({exc.span})"
+    except Exception as exc:  # a crash is what this benchmark exists to find
+        tally.crashes.append(f"{path.name}: {type(exc).__name__}: {exc}")
+        return f"crash: {type(exc).__name__}"
+    drops = [d for d in result.diagnostics if d.kind == "ignored"]
+    tally.silent_drops += sum(d.severity == "info" for d in drops)
+    tally.warned_drops += sum(d.severity != "info" for d in drops)
+    if not result.ok:
+        first = next(d for d in result.diagnostics if d.severity == "error")
+        return f"program: {first.kind}"
+    if post == "kuka":
+        tally.statements_in += statement_lines(path.read_text(encoding="latin-1"))
+        tally.statements_out += sum(
+            statement_lines(text) for name, text in result.files.items() if name.endswith(".src")
+        )
+    return "build"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("folder", nargs="?", type=Path, default=CORPUS)
+    parser.add_argument("--station", type=Path, default=STATION)
+    parser.add_argument("--config-dat", type=Path, default=None)
+    parser.add_argument("--post", default="kuka")
+    parser.add_argument("-v", "--verbose", action="store_true")
+    args = parser.parse_args()
+    config = args.config_dat or find_config(args.folder)
+    start = time.perf_counter()
+    tally = run(args.folder, args.station, config, args.post, args.verbose)
+    seconds = time.perf_counter() - start
+    total = sum(tally.classes.values())
+    for construct, count in tally.constructs.most_common():
+        print(f"  stops on {construct}: {count}")
+    for crash in tally.crashes:
+        print(f"  crash {crash}")
+    ok = tally.classes["build"] + tally.classes["program"]
+    print(f"files: {total} files")
+    print(f"build: {tally.classes['build']} files")
+    print(f"program: {tally.classes['program']} files")
+    print(f"syntax: {tally.classes['syntax']} files")
+    print(f"crash: {tally.classes['crash']} files")
+    print(f"build_or_program: {100.0 * ok / max(total, 1):.1f} %")
+    print(f"silent_drops: {tally.silent_drops} statements")
+    print(f"warned_drops: {tally.warned_drops} statements")
+    print(f"statements_in: {tally.statements_in} statements")
+    print(f"statements_out: {tally.statements_out} statements")
+    print(f"seconds: {seconds:.2f} s")
+
+
+if __name__ == "__main__":
+    main()
