@@ -27,10 +27,13 @@ from typing import TYPE_CHECKING, Any, Literal, TypeAlias, TypeGuard
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from olp.ir_flow import FlowError as FlowError  # re-exported: the flow nodes live there
+from olp.ir_flow import Verbatim as Verbatim
 from olp.span import GENERATED, SourceSpan
 
 if TYPE_CHECKING:
     from typing import Self
+
 
 FloatArray: TypeAlias = NDArray[np.float64]
 IntArray: TypeAlias = NDArray[np.int64]
@@ -377,7 +380,7 @@ class Comment:
 
 Motion: TypeAlias = JointMove | LinearMove | CircularMove
 Instruction: TypeAlias = (
-    JointMove | LinearMove | CircularMove | Wait | SetOutput | WaitInput | Call | Comment
+    JointMove | LinearMove | CircularMove | Wait | SetOutput | WaitInput | Call | Comment | Verbatim
 )
 
 MOTION_TYPES = (JointMove, LinearMove, CircularMove)

@@ -27,7 +27,9 @@ What every post checks (:meth:`Post.check`), so that no brand can forget it:
   (``CALL_ARGUMENTS``): ``Grip(1;MoveAbsJ ...)`` can never write a live move (``call_name``,
   ``call_argument``);
 * digital I/O numbers within the controller's range (``IO_RANGE``, ``io_range``);
-* a station robot of another brand than the post's (a warning, ``foreign_robot``).
+* a station robot of another brand than the post's (a warning, ``foreign_robot``);
+* a :class:`~olp.ir.Verbatim` statement of another language than the post's ``VERBATIM`` is an
+  error naming its line (``verbatim``).
 
 Numbers are written through :meth:`Post.number` with a quantity of ``NUMBERS``
 (:mod:`olp.posts.numbers`): a value the controller cannot hold as checked and timed is an error on
@@ -73,7 +75,17 @@ Transform = Callable[["CompiledProgram", "Post"], "tuple[CompiledProgram, list[D
 """An IR rewrite a language needs before rendering, with the diagnostics it gives."""
 
 ALL_KINDS = frozenset(
-    {"joint", "linear", "circular", "wait", "set_output", "wait_input", "call", "comment"}
+    {
+        "joint",
+        "linear",
+        "circular",
+        "wait",
+        "set_output",
+        "wait_input",
+        "call",
+        "comment",
+        "verbatim",
+    }
 )
 """Instruction kinds of the IR."""
 
@@ -118,6 +130,9 @@ class Post:
     """Digital output and input numbers the controller has (None: no numbers are written)."""
     KINDS: ClassVar[frozenset[str]] = ALL_KINDS
     """Instruction kinds the templates write."""
+    VERBATIM: ClassVar[str | None] = None
+    """The language of :class:`~olp.ir.Verbatim` statements this post writes unchanged (KUKA:
+    ``"krl"``); a verbatim statement of another language is an error on its line."""
     NUMBERS: ClassVar[Mapping[str, NumberFormat]] = {"number": GENERIC_NUMBER}
     FILTERS: ClassVar[Mapping[str, Filter]] = {
         "num": _num,
@@ -283,6 +298,8 @@ class Post:
     def _shared_checks(self, step: Step) -> list[Diagnostic]:
         ins: Any = step.instruction
         kind = ins.kind
+        if kind == "verbatim":
+            return self._verbatim_checks(step, ins)
         if kind not in self.KINDS:
             msg = f"the {self.LANGUAGE} post cannot write a {kind.replace('_', ' ')} instruction"
             return [_error("unsupported", msg, step)]
@@ -300,6 +317,19 @@ class Post:
         except ValueError as exc:
             return [_error("comment", f"comment holds a {exc}: it cannot be written", step)]
         return self._encoding_checks(step, "comment", "\n".join(lines))
+
+    def _verbatim_checks(self, step: Step, ins: Any) -> list[Diagnostic]:
+        """A statement kept as source text goes out unchanged to its own language only; it was
+        checked to be one line when made, so it cannot start another statement."""
+        if ins.language != self.VERBATIM:
+            msg = (
+                f"{ins.language.upper()} statement {_quote(ins.text)} (line {ins.span.line}) is "
+                f"kept verbatim because olp does not model it ({ins.reason}); the "
+                f"{self.LANGUAGE} post cannot write it"
+            )
+            hint = "write it for this controller by hand, or remove it from the source program"
+            return [_error("verbatim", msg, step, hint=hint)]
+        return self._encoding_checks(step, "verbatim", ins.text)
 
     def _call_checks(self, step: Step, name: str, args: Sequence[str]) -> list[Diagnostic]:
         if not self.NAME_RULE.is_legal(name):

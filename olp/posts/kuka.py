@@ -224,6 +224,7 @@ class KukaPost(Post):
     NAME = "kuka"
     VENDOR = "kuka"
     LANGUAGE = "KRL"
+    VERBATIM = "krl"
     NAME_RULE = NAME_RULE
     IO_RANGE = (1, 4096)
     CALL_ARGUMENTS = ArgumentRule(

@@ -81,16 +81,22 @@ def test_pick_reads_the_dat_and_config(pick: KrlResult) -> None:
     kinds = [(type(i).__name__, i.span.line) for i in pick.program]
     assert kinds == [
         ("JointMove", 28),  # PTP XHOME
+        ("Verbatim", 36),  # SET_CD_PARAMS (0): kept as written
         ("JointMove", 37),  # PTP XP1 C_PTP
+        ("Verbatim", 44),
         ("LinearMove", 45),  # LIN XP2
         ("SetOutput", 48),
         ("Wait", 51),
         ("WaitInput", 54),
+        ("Verbatim", 61),
         ("LinearMove", 62),  # LIN XP3 C_DIS C_DIS
+        ("Verbatim", 69),
         ("JointMove", 70),  # PTP XP4 C_PTP
+        ("Verbatim", 91),
         ("LinearMove", 92),  # place_part(), inlined
         ("SetOutput", 95),
         ("Wait", 97),
+        ("Verbatim", 103),
         ("LinearMove", 104),
         ("JointMove", 81),  # back in the main program: PTP XHOME
     ]
@@ -144,7 +150,7 @@ def test_pick_tools_and_bases_come_from_config(pick: KrlResult) -> None:
 
 
 def test_pick_io(pick: KrlResult) -> None:
-    io = [i for i in plain(pick) if not isinstance(i, ir.MOTION_TYPES)]
+    io = [i for i in plain(pick) if not isinstance(i, (*ir.MOTION_TYPES, ir.Verbatim))]
     assert io == [
         ir.SetOutput(index=17, value=True),
         ir.Wait(seconds=0.5),
@@ -172,14 +178,10 @@ def test_pick_lists_every_ignored_line_with_a_reason(pick: KrlResult) -> None:
         87,
         99,
     ]
-    assert [line for line, text in src if text.startswith("SET_CD_PARAMS")] == [
-        36,
-        44,
-        61,
-        69,
-        91,
-        103,
-    ]
+    kept = [(i.span.line, i.text) for i in pick.program if isinstance(i, ir.Verbatim)]
+    lines = [36, 44, 61, 69, 91, 103]  # SET_CD_PARAMS: kept in the program as written
+    assert kept == [(line, "SET_CD_PARAMS (0)") for line in lines]
+    assert not [line for line, text in src if text.startswith("SET_CD_PARAMS")]
     assert by_file["pendant_pick.dat"] == [
         (9, "EXT  BAS (BAS_COMMAND  :IN,REAL  :IN )"),
         (10, "DECL INT SUCCESS"),
@@ -603,6 +605,8 @@ def test_pendant_files_in_other_case_and_crlf(tmp_path: Path, pick: KrlResult) -
                 theirs.frame.number,
             )
             np.testing.assert_array_equal(target_values(ours), target_values(theirs))
+        elif isinstance(ours, ir.Verbatim) and isinstance(theirs, ir.Verbatim):
+            assert ours.text == theirs.text.swapcase()  # kept as written, in its own case
         else:
             assert dataclasses.replace(ours, span=theirs.span) == theirs
     assert [i.span.line for i in result.ignored] == [i.span.line for i in pick.ignored]

@@ -137,7 +137,7 @@ class _Lowering(Motions):
                 f"{routine.name} is a function (DEFFCT): call it in an expression", stmt.span
             )
         elif name in _IGNORED_CALLS:
-            self._ignore(stmt, _IGNORED_CALLS[name])
+            self._keep(stmt, _IGNORED_CALLS[name])
         else:
             args = tuple("" if arg is None else self.sources.snippet(arg.span) for arg in stmt.args)
             self.out.append(ir.Call(name=stmt.name, args=args, span=stmt.span))

@@ -27,8 +27,10 @@ from olp.errors import ParseError
 from olp.frontends.krl.ast import (
     Aggregate,
     Assign,
+    Binary,
     EnumValue,
     Expr,
+    FuncCall,
     IgnoredLine,
     Index,
     Note,
@@ -36,6 +38,7 @@ from olp.frontends.krl.ast import (
     SourceSet,
     StatusTurn,
     Stmt,
+    Unary,
     Var,
 )
 from olp.frontends.krl.data import DataOps, KrlData, text_value
@@ -158,6 +161,45 @@ SYSTEM_REASONS = {
     "$COLLMON_TOL_PRO[]": "collision-detection tolerances are not modelled",
 }
 """Why a system variable olp knows but does not lower is ignored (keys as :attr:`Var.key`)."""
+KEPT_SYSTEM_VARIABLES = frozenset(
+    {
+        "$ACC.CP",
+        "$ACC",
+        "$ACC.ORI1",
+        "$ACC.ORI2",
+        "$VEL.ORI1",
+        "$VEL.ORI2",
+        "$ORI_TYPE",
+        "$CIRC_TYPE",
+        "$APO.CPTP",
+        "$APO.CORI",
+        "$APO.CVEL",
+        "$ADVANCE",
+        "$LOAD",
+        "$GEAR_JERK[]",
+        "$JERK",
+    }
+)
+"""Motion parameters olp does not model yet but must not lose: kept as :class:`~olp.ir.Verbatim`
+(timing does not use them; the KRL post writes them back)."""
+SYSTEM_REASONS = {
+    **SYSTEM_REASONS,
+    "$ACC.ORI1": "orientation acceleration ($ACC.ORI1) is not part of olp's IR",
+    "$ACC.ORI2": "orientation acceleration ($ACC.ORI2) is not part of olp's IR",
+    "$VEL.ORI1": "orientation speed ($VEL.ORI1) is not lowered",
+    "$VEL.ORI2": "orientation speed ($VEL.ORI2) is not lowered",
+}
+
+
+def calls_function(expr: Expr) -> bool:
+    """Whether ``expr`` calls a function anywhere (a call may have effects: RSI_ON(...))."""
+    if isinstance(expr, FuncCall):
+        return True
+    if isinstance(expr, Binary):
+        return calls_function(expr.left) or calls_function(expr.right)
+    if isinstance(expr, Unary):
+        return calls_function(expr.operand)
+    return False
 
 
 # ------------------------------------------------------------------------------------------------
@@ -277,6 +319,12 @@ class Core:
             self._reported.add(key)
             self.ignored.append(IgnoredLine(stmt.span, self.sources.snippet(stmt.span), reason))
 
+    def _keep(self, stmt: Stmt | Assign, reason: str) -> None:
+        """Keep a statement olp does not model as :class:`~olp.ir.Verbatim` (its text without
+        the comment): the KRL post writes it back, other posts stop on it."""
+        text = self.sources.snippet(stmt.span).split(";", 1)[0].strip()
+        self.out.append(ir.Verbatim(text=text, language="krl", reason=reason, span=stmt.span))
+
     def _note(self, span: ir.SourceSpan, message: str, once: str | None = None) -> None:
         key = ("note", once) if once is not None else ("note", span, message)
         if key not in self._reported:
@@ -339,6 +387,8 @@ class Core:
         setter = self._setters.get(key)
         if setter is not None:
             setter(key, stmt.value, stmt)
+        elif key in KEPT_SYSTEM_VARIABLES:
+            self._keep(stmt, SYSTEM_REASONS[key])
         elif key.startswith("$"):
             generic = f"system variable {key.split('[')[0]} is not lowered yet"
             self._ignore(stmt, SYSTEM_REASONS.get(key, generic))
@@ -346,7 +396,9 @@ class Core:
             self._signal_output(stmt)
         else:
             reason = self.data.assign(stmt)
-            if reason is not None:
+            if reason is not None and calls_function(stmt.value):
+                self._keep(stmt, f"{reason}; the call may have effects, so the line is kept")
+            elif reason is not None:
                 self._ignore(stmt, reason)
 
     def _set_vel_cp(self, name: str, value: Expr, stmt: Stmt) -> None:

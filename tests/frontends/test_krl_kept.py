@@ -1,0 +1,75 @@
+"""Nothing a KRL program says is dropped silently (issue 15): what olp does not model is kept as
+written (:class:`olp.ir.Verbatim`) or is a warning, never only an info line."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import olp
+from olp import ir
+from olp.frontends.bundled import KrlOptions
+
+REPO = Path(__file__).resolve().parents[2]
+STATION = REPO / "stations" / "kr6_milling_cell.yaml"
+CORPUS = REPO / "tests" / "corpus" / "krc" / "R1"
+CONFIG = REPO / "examples" / "robot_config.dat"
+
+
+@pytest.fixture(scope="module")
+def station() -> object:
+    return olp.load_station(STATION)
+
+
+def build(station: object, path: Path, post: str = "kuka") -> olp.api.BuildResult:
+    options = KrlOptions(config_dat=CONFIG)
+    return olp.build(station, path, post=post, program_options=options, collisions=None)
+
+
+def test_path_acceleration_reaches_the_krl_output(station: object) -> None:
+    result = build(station, REPO / "examples" / "facing_mill.src")
+    assert result.ok
+    src = result.files["Facing_Mill.src"].splitlines()
+    assert src.count("$ACC.CP = 2.0") == 1
+    assert src.index("$ACC.CP = 2.0") < next(i for i, t in enumerate(src) if t.startswith("LIN"))
+
+
+@pytest.mark.parametrize("post", ["abb", "ur", "fanuc"])
+def test_a_kept_krl_line_is_an_error_for_another_vendor(station: object, post: str) -> None:
+    result = build(station, REPO / "examples" / "facing_mill.src", post)
+    errors = [d for d in result.diagnostics if d.severity == "error"]
+    assert [(d.kind, d.span.line if d.span else None) for d in errors] == [("verbatim", 12)]
+    assert "$ACC.CP = 2.0" in errors[0].message and not result.files
+
+
+def test_calls_with_effects_are_kept_and_skipped_blocks_are_warnings(station: object) -> None:
+    result = build(station, CORPUS / "Program" / "rsi_correction.src")
+    src = result.files["rsi_correction.src"]
+    for line in ('ret=RSI_CREATE("RSI_Ethernet.rsix",CONTID,TRUE)', "ret=RSI_ON(#RELATIVE)"):
+        assert line in src.splitlines()
+    src_file = str(CORPUS / "Program" / "rsi_correction.src")
+    dropped = {
+        d.span.line: d.severity
+        for d in result.diagnostics
+        if d.kind == "ignored" and d.span and d.span.file == src_file
+    }
+    assert dropped[15] == dropped[19] == dropped[24] == "warning"  # IF (ret <> RSIOK) ... HALT
+
+
+def test_no_statement_of_the_program_is_dropped_at_info_level(station: object) -> None:
+    for name in ("pendant_pick.src", "facing_mill.src"):
+        result = build(station, REPO / "examples" / name)
+        src = str(REPO / "examples" / name)
+        ours = [d for d in result.diagnostics if d.span and d.span.file == src]
+        quiet = [d for d in ours if d.severity == "info" and d.kind in ("ignored", "verbatim")]
+        assert quiet and all(d.kind == "verbatim" for d in quiet), [d.format() for d in quiet]
+        assert any(d.kind == "ignored" and d.severity == "warning" for d in result.diagnostics)
+
+
+def test_verbatim_is_one_line() -> None:
+    span = ir.GENERATED
+    with pytest.raises(ir.FlowError, match="one line"):
+        ir.Verbatim(text="$ACC.CP = 2\nPTP {A1 0}", language="krl", span=span)
+    with pytest.raises(ir.FlowError, match="statement"):
+        ir.Verbatim(text="  ", language="krl")
