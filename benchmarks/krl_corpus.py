@@ -20,8 +20,8 @@ Each file lands in one class:
 * ``crash``: any other exception (a bug in olp).
 
 Besides, it counts statements of the ``.src`` olp read but did not put in the output and
-reported only at ``info`` level (``silent_drops``: the issue's "nothing dropped silently" wants 0), and, for the
-files that build with the ``kuka`` post, the statements in and out (``statements_in`` /
+reported only at ``info`` level (``silent_drops``: "nothing dropped silently" wants 0), and, for
+the files that build with the ``kuka`` post, the statements in and out (``statements_in`` /
 ``statements_out``: non-comment, non-blank lines of the first routine and its callees vs. of the
 written program; a KRL -> KRL build should keep every one).
 
