@@ -10,7 +10,11 @@ motion state) -> IR. Data lists (the module's ``.dat``, a ``$config.dat``) are r
 What is lowered
 ---------------
 * **Files.** ``&`` header lines, several ``DEF``/``DEFFCT`` routines, ``;FOLD`` comments. The
-  first ``DEF`` is the program. :func:`load_krl` reads the ``.dat`` beside the ``.src`` (same
+  first ``DEF`` is the program (a module of ``DEFFCT`` functions only is an empty program, each
+  function listed as not lowered). Declarations may leave out ``DECL`` for the simple and the
+  predefined structure types (``FRAME lfOffset``, ``E6AXIS XHOME={...}``, as a controller's
+  ``$config.dat`` writes them); parameters may be arrays (``sText[]:IN``) and functions may
+  return one (``DEFFCT CHAR[128]``). :func:`load_krl` reads the ``.dat`` beside the ``.src`` (same
   name, any case) and, if given, the controller's ``$config.dat``; their ``DECL``\\ s with values
   (``E6POS/POS/FRAME/E6AXIS/AXIS``, ``PDAT/LDAT/FDAT``, numbers, ...) and value assignments
   (``TOOL_DATA[1]={...}``, ``TOOL_NAME[1,]="..."``) are the program's global variables; the
@@ -74,7 +78,11 @@ What is lowered
   of constants are kept for later use; others make the variable unknown and are listed.
 
 Nothing is dropped silently: every statement olp recognised but did not lower is in
-:attr:`KrlResult.ignored` with the reason (also those of the data lists). Text the grammar does
+:attr:`KrlResult.ignored` with the reason (also those of the data lists; the frontend reports
+the program's own as warnings). Statements that matter to the controller but that olp does not
+model (motion parameters such as ``$ACC.CP`` and ``$ORI_TYPE``, assignments that call functions,
+``SET_CD_PARAMS``, ``PULSE``, ``ON_ERROR_PROCEED``, ``RESUME``) are kept in the program as
+:class:`olp.ir.Verbatim`: the KRL post writes them back, other posts stop on them. Text the grammar does
 not accept, and values olp needs but cannot use, raise :class:`olp.errors.ParseError` with file,
 line, column, what was expected and the offending text.
 """

@@ -350,6 +350,7 @@ Stmt: TypeAlias = (
 class Param:
     name: str
     direction: str | None  # "IN", "OUT" or not given
+    array: bool = False  # written with empty brackets: sText[]:IN
 
 
 @dataclass(frozen=True, slots=True)

@@ -9,6 +9,7 @@ lowering it would change nothing, and rejected (naming the construct and its lin
 from __future__ import annotations
 
 import dataclasses
+import os
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -64,6 +65,8 @@ MAX_FOR_ITERATIONS = 1_000_000
 MAX_LOWERED_STATEMENTS = 2_000_000
 """Statements (and loop iterations) lowered in one run, counting every unrolled and inlined copy:
 bounds the time and memory a small file can ask for through nested loops."""
+_KEPT_OTHERS = frozenset({"RESUME", "ON_ERROR_PROCEED"})
+"""Statements that change how the controller runs the program: kept as written."""
 _IGNORED_CALLS = {
     "SET_CD_PARAMS": "collision-detection parameters are not modelled",
     "PULSE": "PULSE outputs are not lowered yet",
@@ -350,6 +353,8 @@ class _Lowering(Motions):
             raise self._error("GOTO is not supported (olp's IR has no control flow)", stmt.span)
         elif stmt.kind == "EXIT" and self.loop_depth > 0:
             self.exiting = stmt.span.line
+        elif stmt.kind in _KEPT_OTHERS:
+            self._keep(stmt, OTHER_REASONS[stmt.kind])
         else:
             self._ignore(stmt, OTHER_REASONS[stmt.kind])
 
@@ -363,7 +368,10 @@ def lower_module(
 ) -> KrlResult:
     """Lower the first DEF of ``module``; the other routines are inlined where called."""
     routines = _routines(module, sources, src)
-    main = routines[0]
+    if not any(r.kind == "DEF" for r in routines):
+        return _functions_only(routines, sources, src, dat, config)
+    main = next(r for r in routines if r.kind == "DEF")
+    routines = [main, *(r for r in routines if r is not main)]
     table = {r.name.upper(): r for r in routines}
     ctx = Context(sources, table, src, dat, config, MAX_LOWERED_STATEMENTS)
     data = [d for d in (config, dat) if d is not None]
@@ -411,13 +419,39 @@ def _routines(module: Module, sources: SourceSet, src: str) -> list[Routine]:
         source = sources.source(src)
         line, column = source.last_position() if source is not None else (1, 1)
         raise sources.error("no DEF ... END routine found", ir.SourceSpan(src, line, column))
-    if routines[0].kind != "DEF":
-        raise sources.error(
-            f"the first routine must be a DEF, found {routines[0].kind}", routines[0].span
-        )
     seen: set[str] = set()
     for routine in routines:
         if routine.name.upper() in seen:
             raise sources.error(f"{routine.kind} {routine.name} is defined twice", routine.span)
         seen.add(routine.name.upper())
     return routines
+
+
+def _functions_only(
+    routines: list[Routine],
+    sources: SourceSet,
+    src: str,
+    dat: KrlData | None,
+    config: KrlData | None,
+) -> KrlResult:
+    """A module of functions only (a library of DEFFCTs, called from other modules): there is no
+    program to run, so the program is empty and every function is reported as not lowered."""
+    names = ", ".join(r.name for r in routines)
+    ignored = [
+        IgnoredLine(
+            r.span,
+            sources.snippet(r.span),
+            f"the module holds only functions ({names}) and no DEF to run; olp does not lower "
+            "functions yet",
+        )
+        for r in routines
+    ]
+    for data_list in (dat, config):
+        ignored.extend(data_list.ignored if data_list is not None else ())
+    name = os.path.splitext(os.path.basename(src))[0] or routines[0].name
+    data = [d for d in (config, dat) if d is not None]
+    return KrlResult(
+        program=ir.Program(name=name, instructions=(), source=src),
+        ignored=tuple(ignored),
+        data_sources=tuple(d.filename for d in data),
+    )

@@ -90,6 +90,8 @@ _OTHER_KINDS = {
     "exit_stmt": "EXIT",
     "continue_stmt": "CONTINUE",
     "brake_stmt": "BRAKE",
+    "resume_stmt": "RESUME",
+    "on_error_stmt": "ON_ERROR_PROCEED",
 }
 
 
@@ -110,13 +112,27 @@ class _With:
 _NOT_TARGETS = (_CircAngle, _With, Token)
 
 
-class _ToAst(Transformer[Token, Module]):
-    """Builds the AST; never raises for any tree the grammar accepts."""
+DECL_FREE_TYPES = frozenset({"FRAME", "POS", "E6POS", "AXIS", "E6AXIS", "LOAD"})
+"""Structure types a declaration may name without DECL, as controllers' own files do
+(``E6AXIS XHOME={...}``, ``FRAME TOOL_CORR={...}``, ``LOAD LOAD_A1_DATA={...}`` in
+``$config.dat``; ``FRAME lfOffset`` in programs). Seen in public KR C4 backups; the KSS manual's
+exact rule is not quoted here, so olp accepts only these (and the simple types)."""
 
-    def __init__(self, filename: str, runs: dict[int, tuple[FastMotion, ...]]) -> None:
+
+class _ToAst(Transformer[Token, Module]):
+    """Builds the AST; never raises for any tree the grammar accepts, except for a declaration
+    without DECL of a type that may not be declared so (:data:`DECL_FREE_TYPES`)."""
+
+    def __init__(
+        self, filename: str, runs: dict[int, tuple[FastMotion, ...]], lines: Sequence[str] = ()
+    ) -> None:
         super().__init__(visit_tokens=True)
         self._filename = filename
         self._runs = runs
+        self._lines = lines
+
+    def _source_line(self, number: int) -> str | None:
+        return self._lines[number - 1] if 1 <= number <= len(self._lines) else None
 
     def _span(self, meta: Meta) -> ir.SourceSpan:
         return ir.SourceSpan(self._filename, meta.line, meta.column, meta.end_line, meta.end_column)
@@ -170,7 +186,7 @@ class _ToAst(Transformer[Token, Module]):
 
     @_inline
     def function(
-        self, meta: Meta, _global: Any, _type: Any, name: Token, params: Any, body: Any
+        self, meta: Meta, _global: Any, _type: Any, _dims: Any, name: Token, params: Any, body: Any
     ) -> Routine:
         return Routine("DEFFCT", str(name), params or (), body, self._span(meta))
 
@@ -178,8 +194,10 @@ class _ToAst(Transformer[Token, Module]):
         return tuple(children)
 
     @_inline
-    def param(self, meta: Meta, name: Token, direction: Token | None) -> Param:
-        return Param(str(name), None if direction is None else str(direction).upper())
+    def param(self, meta: Meta, name: Token, array: Token | None, direction: Token | None) -> Param:
+        return Param(
+            str(name), None if direction is None else str(direction).upper(), array is not None
+        )
 
     @_inline
     def dat_block(self, meta: Meta, name: Token, _public: Any, body: tuple[Stmt, ...]) -> DatBlock:
@@ -258,6 +276,25 @@ class _ToAst(Transformer[Token, Module]):
         type_name = next(c for c in children if isinstance(c, str) and not isinstance(c, Token))
         items = tuple(c for c in children if isinstance(c, DeclItem))
         return Decl(type_name.upper(), items, self._span(meta))
+
+    @_inline
+    def bare_decl(self, meta: Meta, *children: Any) -> Decl:
+        """A declaration without DECL (``FRAME lfOffset``): the type is the name before the
+        first item, after any GLOBAL/CONST. Only the predefined structure types may be declared
+        so (:data:`DECL_FREE_TYPES`); anything else is a located error, so that a misspelt
+        statement (``PTPP XP1``) is never taken for a declaration."""
+        items = tuple(c for c in children if isinstance(c, DeclItem))
+        type_name = next(c for c in children if isinstance(c, Token) and c.type == "NAME")
+        if type_name.upper() not in DECL_FREE_TYPES:
+            first = items[0]
+            known = ", ".join(sorted(DECL_FREE_TYPES))
+            raise ParseError(
+                f"unexpected {first.name!r} after {str(type_name)!r}: {type_name} is not a "
+                f"statement, and only the predefined types ({known}) are declared without DECL",
+                first.span,
+                self._source_line(first.span.line),
+            )
+        return Decl(str(type_name).upper(), items, self._span(meta))
 
     @_inline
     def type_name(self, meta: Meta, name: Any) -> str:
@@ -438,7 +475,7 @@ def parse_module(source: Source, fast: bool = True) -> Module:
 
 def _parse(text: str, filename: str, runs: dict[int, tuple[FastMotion, ...]], fast: bool) -> Module:
     tree = _parser(fast).parse(text + "\n")
-    return _ToAst(filename, runs).transform(tree)
+    return _ToAst(filename, runs, text.split("\n")).transform(tree)
 
 
 def _substitute_fast_runs(source: Source) -> tuple[str, dict[int, tuple[FastMotion, ...]]]:
