@@ -17,6 +17,8 @@ Each file lands in one class:
 * ``program``: stopped on program-level diagnostics only (unreachable, limits, ...);
 * ``syntax``: stopped on an :class:`olp.errors.OlpError` (olp cannot read or lower something),
   counted by construct (the keyword at the error, or the block it sits in);
+* ``post``: read, but the post cannot write something the program says (control flow, a line
+  kept verbatim for another language), counted by the post's diagnostic kind;
 * ``crash``: any other exception (a bug in olp).
 
 Besides, it counts statements of the ``.src`` olp read but did not put in the output and
@@ -49,6 +51,8 @@ _KEYWORD_TEXT = (
     "CONST FRAME E6AXIS E6POS POS AXIS INT REAL BOOL CHAR"
 )
 _KEYWORDS = frozenset(_KEYWORD_TEXT.split())
+POST_KINDS = frozenset({"control_flow", "verbatim", "unsupported"})
+"""Errors of a post that cannot write what the program says: not the program's fault."""
 _INSIDE = re.compile(r"inside the (\w+) at line")
 _WORD = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]*")
 
@@ -138,8 +142,12 @@ def _one(olp, path, station, options, post, tally, olp_error) -> str:  # type: i
     tally.silent_drops += sum(d.severity == "info" for d in drops)
     tally.warned_drops += sum(d.severity != "info" for d in drops)
     if not result.ok:
-        first = next(d for d in result.diagnostics if d.severity == "error")
-        return f"program: {first.kind}"
+        errors = [d for d in result.diagnostics if d.severity == "error"]
+        unwritable = [d for d in errors if d.kind in POST_KINDS]
+        if unwritable:
+            tally.constructs[f"post: {unwritable[0].kind}"] += 1
+            return f"post: {unwritable[0].kind}"
+        return f"program: {errors[0].kind}"
     if post == "kuka":
         tally.statements_in += statement_lines(path.read_text(encoding="latin-1"))
         tally.statements_out += sum(
@@ -170,6 +178,7 @@ def main() -> None:
     print(f"build: {tally.classes['build']} files")
     print(f"program: {tally.classes['program']} files")
     print(f"syntax: {tally.classes['syntax']} files")
+    print(f"post: {tally.classes['post']} files")
     print(f"crash: {tally.classes['crash']} files")
     print(f"build_or_program: {100.0 * ok / max(total, 1):.1f} %")
     print(f"silent_drops: {tally.silent_drops} statements")

@@ -130,6 +130,10 @@ class Post:
     """Digital output and input numbers the controller has (None: no numbers are written)."""
     KINDS: ClassVar[frozenset[str]] = ALL_KINDS
     """Instruction kinds the templates write."""
+    WRITES_FLOW: ClassVar[bool] = False
+    """Whether the templates write control flow and data statements (:mod:`olp.ir_flow`); a
+    post that does not stops on a program holding them, naming the first one, rather than
+    writing its instructions in a row."""
     VERBATIM: ClassVar[str | None] = None
     """The language of :class:`~olp.ir.Verbatim` statements this post writes unchanged (KUKA:
     ``"krl"``); a verbatim statement of another language is an error on its line."""
@@ -198,6 +202,8 @@ class Post:
     def check(self, compiled: CompiledProgram) -> list[Diagnostic]:
         """Everything this post reports about ``compiled``; errors mean nothing is written."""
         out = self._foreign_robot(compiled)
+        if compiled.program.has_flow and not self.WRITES_FLOW:
+            return [*out, self._flow_error(compiled)]
         for step in compiled.steps:
             out += self._shared_checks(step)
             out += self.check_instruction(step, compiled)
@@ -317,6 +323,21 @@ class Post:
         except ValueError as exc:
             return [_error("comment", f"comment holds a {exc}: it cannot be written", step)]
         return self._encoding_checks(step, "comment", "\n".join(lines))
+
+    def _flow_error(self, compiled: CompiledProgram) -> Diagnostic:
+        from olp.ir_flow import FLOW_TYPES, leaves_and_blocks
+
+        first = next(
+            n for n in leaves_and_blocks(compiled.program.instructions) if isinstance(n, FLOW_TYPES)
+        )
+        what = first.kind.replace("_", " ")
+        return Diagnostic(
+            "error",
+            "control_flow",
+            f"the {self.LANGUAGE} post does not write control flow and data statements yet "
+            f"(first: {what} at line {first.span.line}); nothing of the program is written",
+            first.span,
+        )
 
     def _verbatim_checks(self, step: Step, ins: Any) -> list[Diagnostic]:
         """A statement kept as source text goes out unchanged to its own language only; it was

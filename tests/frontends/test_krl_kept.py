@@ -10,6 +10,7 @@ import pytest
 import olp
 from olp import ir
 from olp.frontends.bundled import KrlOptions
+from olp.frontends.krl import load_krl
 
 REPO = Path(__file__).resolve().parents[2]
 STATION = REPO / "stations" / "kr6_milling_cell.yaml"
@@ -43,18 +44,23 @@ def test_a_kept_krl_line_is_an_error_for_another_vendor(station: object, post: s
     assert "$ACC.CP = 2.0" in errors[0].message and not result.files
 
 
-def test_calls_with_effects_are_kept_and_skipped_blocks_are_warnings(station: object) -> None:
-    result = build(station, CORPUS / "Program" / "rsi_correction.src")
-    src = result.files["rsi_correction.src"]
-    for line in ('ret=RSI_CREATE("RSI_Ethernet.rsix",CONTID,TRUE)', "ret=RSI_ON(#RELATIVE)"):
-        assert line in src.splitlines()
-    src_file = str(CORPUS / "Program" / "rsi_correction.src")
-    dropped = {
-        d.span.line: d.severity
-        for d in result.diagnostics
-        if d.kind == "ignored" and d.span and d.span.file == src_file
-    }
-    assert dropped[15] == dropped[19] == dropped[24] == "warning"  # IF (ret <> RSIOK) ... HALT
+def test_calls_with_effects_and_the_checks_of_their_results_are_kept() -> None:
+    result = load_krl(CORPUS / "Program" / "rsi_correction.src", CONFIG)
+    kinds = [(n.kind, n.span.line) for n in result.program.instructions]
+    assert [k for k in kinds if k[0] in ("assign", "if")] == [
+        ("assign", 14),  # ret=RSI_CREATE(...)
+        ("if", 15),  # IF (ret <> RSIOK) THEN HALT ENDIF
+        ("assign", 18),
+        ("if", 19),
+        ("assign", 23),
+        ("if", 24),
+    ]
+    create = result.program.instructions[[k for k, _ in kinds].index("assign", 2)]
+    assert isinstance(create, ir.Assign) and isinstance(create.value, ir.FunctionCall)
+    assert create.value.name == "RSI_CREATE" and len(create.value.args) == 3
+    check = next(n for n in result.program.instructions if isinstance(n, ir.If))
+    (halt,) = check.branches[0].body
+    assert isinstance(halt, ir.Verbatim) and halt.text == "HALT"
 
 
 def test_no_statement_of_the_program_is_dropped_at_info_level(station: object) -> None:

@@ -65,13 +65,25 @@ What is lowered
   arguments are constant; others are unknown inside; parameters not marked ``:IN`` are copied
   back to a plain variable argument); recursion is an error. Other calls become
   :class:`~olp.ir.Call` (arguments as source text).
-* **FOR** loops with constant integer bounds are unrolled (at most
-  :data:`~olp.frontends.krl.lower.MAX_FOR_ITERATIONS` iterations, and
-  :data:`~olp.frontends.krl.lower.MAX_LOWERED_STATEMENTS` statements in all). Other control
-  flow (``IF``, ``WHILE``, ``LOOP``, ``REPEAT``, ``SWITCH``, FOR with other bounds) is ignored
-  when lowering its bodies would change nothing (variables they assign become unknown), and
-  rejected otherwise, naming the construct and its line. ``SPLINE ... ENDSPLINE`` blocks and
-  ``GOTO`` are rejected.
+* **Control flow** becomes :mod:`olp.ir_flow` blocks (re-exported from :mod:`olp.ir`): ``IF``
+  -> :class:`~olp.ir.If`, ``SWITCH`` -> :class:`~olp.ir.Switch`, ``WHILE``/``REPEAT``/``LOOP``
+  -> :class:`~olp.ir.While`/:class:`~olp.ir.Repeat`/:class:`~olp.ir.Loop`, ``EXIT`` ->
+  :class:`~olp.ir.Exit`, labels and ``GOTO`` -> :class:`~olp.ir.Label`/:class:`~olp.ir.Goto`,
+  conditions as :mod:`olp.ir_flow` expressions. Each body is lowered from the state that
+  reaches it; after a block, a variable keeps its value only where every path agrees, and a
+  motion setting (speed, zone, tool, base) that differs between the paths is an error at the
+  next motion that relies on it (the inline forms set them again, so pendant programs pass). A
+  loop's body starts from the join of the state before it and after a pass (variables it
+  assigns are unknown inside). ``FOR`` loops with constant integer bounds over straight-line
+  code are unrolled (at most :data:`~olp.frontends.krl.lower.MAX_FOR_ITERATIONS` iterations,
+  and :data:`~olp.frontends.krl.lower.MAX_LOWERED_STATEMENTS` statements in all); others are a
+  :class:`~olp.ir.For` block. A jump back to a label makes the variables the routine assigns
+  unknown there; one with other motion settings than the label had is an error. ``SPLINE ...
+  ENDSPLINE`` blocks are rejected. ``RETURN`` inside a block of an inlined routine is rejected.
+* **Data.** Declarations in the program are :class:`~olp.ir.Declare`, assignments of the
+  program's variables :class:`~olp.ir.Assign` (their constant values are also used, as before);
+  what the inline forms assign for BAS (``PDAT_ACT``, ``LDAT_ACT``, ``FDAT_ACT``) is absorbed
+  into the motions. ``WAIT FOR`` a condition other than an input is :class:`~olp.ir.WaitUntil`.
 * **I/O and waits.** ``WAIT SEC`` -> Wait; ``WAIT FOR $IN[n]`` (or ``NOT``, ``== TRUE/FALSE``, a
   one-bit ``SIGNAL``) -> WaitInput; ``$OUT[n] = TRUE/FALSE`` (or a SIGNAL) -> SetOutput.
 * **Variables.** Constant expressions are evaluated (KRL rules: INT/INT truncates); assignments
@@ -82,9 +94,10 @@ Nothing is dropped silently: every statement olp recognised but did not lower is
 the program's own as warnings). Statements that matter to the controller but that olp does not
 model (motion parameters such as ``$ACC.CP`` and ``$ORI_TYPE``, assignments that call functions,
 ``SET_CD_PARAMS``, ``PULSE``, ``ON_ERROR_PROCEED``, ``RESUME``) are kept in the program as
-:class:`olp.ir.Verbatim`: the KRL post writes them back, other posts stop on them. Text the grammar does
-not accept, and values olp needs but cannot use, raise :class:`olp.errors.ParseError` with file,
-line, column, what was expected and the offending text.
+:class:`olp.ir.Verbatim`: the KRL post writes them back, other posts stop on them.
+
+Text the grammar does not accept, and values olp needs but cannot use, raise
+:class:`olp.errors.ParseError` with file, line, column, what was expected and the offending text.
 """
 
 from __future__ import annotations

@@ -112,6 +112,20 @@ class _With:
 _NOT_TARGETS = (_CircAngle, _With, Token)
 
 
+class _Case:
+    __slots__ = ("body", "values")
+
+    def __init__(self, values: tuple[Expr, ...], body: tuple[Stmt, ...]) -> None:
+        self.values, self.body = values, body
+
+
+class _Default:
+    __slots__ = ("body",)
+
+    def __init__(self, body: tuple[Stmt, ...]) -> None:
+        self.body = body
+
+
 DECL_FREE_TYPES = frozenset({"FRAME", "POS", "E6POS", "AXIS", "E6AXIS", "LOAD"})
 """Structure types a declaration may name without DECL, as controllers' own files do
 (``E6AXIS XHOME={...}``, ``FRAME TOOL_CORR={...}``, ``LOAD LOAD_A1_DATA={...}`` in
@@ -323,8 +337,9 @@ class _ToAst(Transformer[Token, Module]):
         return Block(keyword, kept, self._span(meta))
 
     @_inline
-    def if_stmt(self, meta: Meta, _cond: Expr, then: Any, otherwise: Any) -> Block:
-        return self._block("IF", meta, (then, otherwise))
+    def if_stmt(self, meta: Meta, cond: Expr, then: Any, otherwise: Any) -> Block:
+        bodies = (then or (), otherwise or ())
+        return Block("IF", bodies, self._span(meta), (cond,), (), otherwise is not None)
 
     @_inline
     def for_stmt(
@@ -333,28 +348,40 @@ class _ToAst(Transformer[Token, Module]):
         return ForLoop(str(counter), start, end, step, body, self._span(meta))
 
     @_inline
-    def while_stmt(self, meta: Meta, _cond: Expr, body: Any) -> Block:
-        return self._block("WHILE", meta, (body,))
+    def while_stmt(self, meta: Meta, cond: Expr, body: Any) -> Block:
+        return Block("WHILE", (body or (),), self._span(meta), (cond,))
 
     @_inline
     def loop_stmt(self, meta: Meta, body: Any) -> Block:
         return self._block("LOOP", meta, (body,))
 
     @_inline
-    def repeat_stmt(self, meta: Meta, body: Any, _cond: Expr) -> Block:
-        return self._block("REPEAT", meta, (body,))
+    def repeat_stmt(self, meta: Meta, body: Any, until: Expr) -> Block:
+        return Block("REPEAT", (body or (),), self._span(meta), (until,))
 
     @_inline
-    def switch_stmt(self, meta: Meta, _subject: Expr, *clauses: Any) -> Block:
-        return self._block("SWITCH", meta, clauses)
+    def switch_stmt(self, meta: Meta, subject: Expr, *clauses: Any) -> Block:
+        cases = [c for c in clauses if isinstance(c, _Case)]
+        default = next((c for c in clauses if isinstance(c, _Default)), None)
+        bodies = (*(c.body for c in cases), () if default is None else default.body)
+        values = tuple(c.values for c in cases)
+        return Block("SWITCH", bodies, self._span(meta), (subject,), values, default is not None)
 
     @_inline
-    def case_clause(self, meta: Meta, _values: Any, body: tuple[Stmt, ...]) -> tuple[Stmt, ...]:
-        return body
+    def case_clause(self, meta: Meta, values: tuple[Expr, ...], body: Any) -> _Case:
+        return _Case(values, body or ())
 
     @_inline
-    def default_clause(self, meta: Meta, body: tuple[Stmt, ...]) -> tuple[Stmt, ...]:
-        return body
+    def default_clause(self, meta: Meta, body: Any) -> _Default:
+        return _Default(body or ())
+
+    @_inline
+    def goto_stmt(self, meta: Meta, name: Token) -> Other:
+        return Other("GOTO", self._span(meta), str(name))
+
+    @_inline
+    def label(self, meta: Meta, name: Token) -> Other:
+        return Other("label", self._span(meta), str(name))
 
     # ---- expressions
     @_inline

@@ -191,6 +191,11 @@ SYSTEM_REASONS = {
 }
 
 
+INLINE_FORM_DATA = frozenset({"PDAT_ACT", "LDAT_ACT", "FDAT_ACT"})
+"""What the pendant's inline forms assign for BAS to read: absorbed into the motions' speeds,
+zones, tools and bases (:mod:`olp.frontends.krl.inline`), not kept as assignments."""
+
+
 def calls_function(expr: Expr) -> bool:
     """Whether ``expr`` calls a function anywhere (a call may have effects: RSI_ON(...))."""
     if isinstance(expr, FuncCall):
@@ -288,7 +293,7 @@ class Core:
         self.variables = variables
         self.evaluator = Evaluator(variables, ctx.sources.snippet)
         self.data = DataOps(variables, self.evaluator, ctx.sources)
-        self.out: list[ir.Instruction | Pending] = []
+        self.out: list[ir.Node | Pending] = []
         self.ignored: list[IgnoredLine] = []
         self.notes: list[Note] = []
         self.status_turn: list[StatusTurn] = []
@@ -318,6 +323,14 @@ class Core:
         if key not in self._reported:
             self._reported.add(key)
             self.ignored.append(IgnoredLine(stmt.span, self.sources.snippet(stmt.span), reason))
+
+    def _assignment(self, stmt: Assign) -> ir.Assign:
+        """``stmt`` as IR: a statement of the program, kept whatever olp knows of its value."""
+        from olp.frontends.krl.flow import to_expr
+
+        target, value = (to_expr(e, lambda _: None) for e in (stmt.target, stmt.value))
+        assert target is not None and value is not None
+        return ir.Assign(target=target, value=value, span=stmt.span)
 
     def _keep(self, stmt: Stmt | Assign, reason: str) -> None:
         """Keep a statement olp does not model as :class:`~olp.ir.Verbatim` (its text without
@@ -395,11 +408,9 @@ class Core:
         elif self._is_signal(stmt.target):
             self._signal_output(stmt)
         else:
-            reason = self.data.assign(stmt)
-            if reason is not None and calls_function(stmt.value):
-                self._keep(stmt, f"{reason}; the call may have effects, so the line is kept")
-            elif reason is not None:
-                self._ignore(stmt, reason)
+            self.data.assign(stmt)  # what olp knows of the value afterwards
+            if stmt.target.name.upper() not in INLINE_FORM_DATA:
+                self.out.append(self._assignment(stmt))
 
     def _set_vel_cp(self, name: str, value: Expr, stmt: Stmt) -> None:
         self._vel_cp(self._number(value, "$VEL.CP (m/s)"), value.span)
@@ -607,7 +618,7 @@ def element_span(element: Value, default: ir.SourceSpan) -> ir.SourceSpan:
     return span if isinstance(span, ir.SourceSpan) else default
 
 
-def build_instructions(out: Sequence[ir.Instruction | Pending]) -> tuple[ir.Instruction, ...]:
+def build_instructions(out: Sequence[ir.Node | Pending]) -> tuple[ir.Node, ...]:
     """The instructions, with all Cartesian poses computed in one vectorised call."""
     values = []
     for item in out:
@@ -617,7 +628,7 @@ def build_instructions(out: Sequence[ir.Instruction | Pending]) -> tuple[ir.Inst
             if item.via is not None:
                 values.append(item.via.values)
     poses = iter(frame_to_pose(np.array(values, dtype=np.float64).reshape(-1, 6)))
-    built: list[ir.Instruction] = []
+    built: list[ir.Node] = []
     for item in out:
         if not isinstance(item, Pending):
             built.append(item)
