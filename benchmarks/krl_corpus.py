@@ -23,9 +23,11 @@ Each file lands in one class:
 
 Besides, it counts statements of the ``.src`` olp read but did not put in the output and
 reported only at ``info`` level (``silent_drops``: "nothing dropped silently" wants 0), and, for
-the files that build with the ``kuka`` post, the statements in and out (``statements_in`` /
-``statements_out``: non-comment, non-blank lines of the first routine and its callees vs. of the
-written program; a KRL -> KRL build should keep every one).
+the files that build, where each statement of the ``.src`` went: ``kept`` (a node of the
+program's IR carries its line, so the KRL post writes it), ``absorbed`` into the motions' speeds,
+zones, tools and bases (inline-form data, BAS, ``$VEL``/``$TOOL``/``$BASE``/``$APO``), an
+``inlined`` call of the module's own DEF, ``warned`` (reported as not in the output), or
+``unaccounted`` (the figure that must be 0: listed).
 
 The last lines are ``name: value unit``.
 """
@@ -67,7 +69,11 @@ class Tally:
     silent_drops: int = 0
     warned_drops: int = 0
     statements_in: int = 0
-    statements_out: int = 0
+    kept: int = 0
+    absorbed: int = 0
+    inlined: int = 0
+    warned: int = 0
+    unaccounted: list[str] = field(default_factory=list)
 
 
 def construct_of(message: str, source_line: str | None) -> str:
@@ -85,17 +91,63 @@ def construct_of(message: str, source_line: str | None) -> str:
     return "other: " + " ".join(message.split()[:5])
 
 
-def statement_lines(text: str) -> int:
-    """Lines that hold a statement: not blank, not only a comment, not a header or DEF/END."""
-    count = 0
-    for raw in text.splitlines():
+_STRUCTURE = re.compile(
+    r"(?i)((GLOBAL\s+)?(DEF|DEFFCT)|END|ENDFCT|ELSE|ENDIF|ENDWHILE|ENDLOOP|ENDFOR|ENDSWITCH|CASE|"
+    r"DEFAULT|UNTIL)\b"
+)
+_ABSORBED = re.compile(
+    r"(?i)(BAS\s*\(|(PDAT_ACT|LDAT_ACT|FDAT_ACT)\s*=|\$(VEL|VEL_AXIS|ACC_AXIS|APO|TOOL|BASE|H_POS|"
+    r"IPO_MODE)\b)"
+)
+_ROUTINE = re.compile(r"(?i)(GLOBAL\s+)?(DEF|DEFFCT)\b")
+_CALL = re.compile(r"\s*([A-Za-z_][A-Za-z0-9_]*)\s*\(")
+
+
+def statement_lines(text: str) -> dict[int, str]:
+    """Line number -> text of the lines that hold a statement (not blank, not only a comment,
+    not a header, not a line that only opens, divides or closes a routine or a block)."""
+    found = {}
+    for number, raw in enumerate(text.splitlines(), start=1):
         line = raw.split(";", 1)[0].strip()
-        if not line or line.startswith("&"):
-            continue
-        if re.match(r"(?i)(GLOBAL\s+)?(DEF|DEFFCT|END|ENDFCT|DEFDAT|ENDDAT)\b", line):
-            continue
-        count += 1
-    return count
+        if line and not line.startswith("&") and not _STRUCTURE.match(line):
+            found[number] = line
+    return found
+
+
+def account(text: str, src: str, result: object, tally: Tally) -> None:
+    """Where every statement of the program went: kept (an IR node has its line), absorbed
+    into the motions (inline-form data, BAS, $VEL/$TOOL/... settings), an inlined call, a
+    warning, or unaccounted (lost without a word: the figure that must be 0)."""
+    from olp.ir_flow import leaves_and_blocks
+
+    program = result.compiled.program  # type: ignore[attr-defined]
+    lines = statement_lines(text)
+    kept = {n.span.line for n in leaves_and_blocks(program.instructions) if n.span.file == src}
+    warned = {
+        d.span.line
+        for d in result.diagnostics  # type: ignore[attr-defined]
+        if d.span is not None and d.span.file == src and d.severity in ("warning", "error")
+    }
+    routines = {
+        m.group(1).upper() for m in re.finditer(r"(?im)^\s*(?:GLOBAL\s+)?DEF\s+(\w+)", text)
+    }
+    starts = [n for n, raw in enumerate(text.splitlines(), start=1) if _ROUTINE.match(raw.strip())]
+    for number, line in lines.items():
+        head = max((n for n in starts if n <= number), default=0)
+        if head in warned:  # a routine olp does not write (never called, functions only)
+            warned.add(number)
+        call = _CALL.match(line)
+        tally.statements_in += 1
+        if number in kept:
+            tally.kept += 1
+        elif _ABSORBED.match(line):
+            tally.absorbed += 1
+        elif call is not None and call.group(1).upper() in routines:
+            tally.inlined += 1
+        elif number in warned:
+            tally.warned += 1
+        else:
+            tally.unaccounted.append(f"{src}:{number}: {line}")
 
 
 def find_config(folder: Path) -> Path | None:
@@ -148,11 +200,8 @@ def _one(olp, path, station, options, post, tally, olp_error) -> str:  # type: i
             tally.constructs[f"post: {unwritable[0].kind}"] += 1
             return f"post: {unwritable[0].kind}"
         return f"program: {errors[0].kind}"
-    if post == "kuka":
-        tally.statements_in += statement_lines(path.read_text(encoding="latin-1"))
-        tally.statements_out += sum(
-            statement_lines(text) for name, text in result.files.items() if name.endswith(".src")
-        )
+    text = path.read_text(encoding="latin-1")
+    account(text, src, result, tally)
     return "build"
 
 
@@ -183,8 +232,14 @@ def main() -> None:
     print(f"build_or_program: {100.0 * ok / max(total, 1):.1f} %")
     print(f"silent_drops: {tally.silent_drops} statements")
     print(f"warned_drops: {tally.warned_drops} statements")
+    for line in tally.unaccounted:
+        print(f"  unaccounted {line}")
     print(f"statements_in: {tally.statements_in} statements")
-    print(f"statements_out: {tally.statements_out} statements")
+    print(f"statements_kept: {tally.kept} statements")
+    print(f"statements_absorbed: {tally.absorbed} statements")
+    print(f"statements_inlined_calls: {tally.inlined} statements")
+    print(f"statements_warned: {tally.warned} statements")
+    print(f"statements_unaccounted: {len(tally.unaccounted)} statements")
     print(f"seconds: {seconds:.2f} s")
 
 

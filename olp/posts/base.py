@@ -86,8 +86,9 @@ ALL_KINDS = frozenset(
         "comment",
         "verbatim",
     }
+    | {"declare", "assign", "wait_until", "label", "goto", "exit", "return"}
 )
-"""Instruction kinds of the IR."""
+"""Instruction kinds of the IR (a program's blocks are not instructions: see ``WRITES_FLOW``)."""
 
 GENERIC_NUMBER = NumberFormat("number", "", 3)
 """The ``num`` filter's format where a template names no quantity (range: any finite value)."""

@@ -63,6 +63,18 @@ def test_calls_with_effects_and_the_checks_of_their_results_are_kept() -> None:
     assert isinstance(halt, ir.Verbatim) and halt.text == "HALT"
 
 
+def test_the_krl_post_writes_the_calls_and_their_checks(station: object) -> None:
+    result = build(station, CORPUS / "Program" / "rsi_correction.src")
+    lines = result.files["rsi_correction.src"].replace("\r", "").splitlines()
+    start = lines.index('ret = RSI_CREATE("RSI_Ethernet.rsix", CONTID, TRUE)')
+    assert lines[start + 1 : start + 5] == [
+        "IF ret <> RSIOK THEN",
+        "HALT",
+        "ENDIF",
+        "ret = RSI_ON(#RELATIVE)",
+    ]
+
+
 def test_no_statement_of_the_program_is_dropped_at_info_level(station: object) -> None:
     for name in ("pendant_pick.src", "facing_mill.src"):
         result = build(station, REPO / "examples" / name)

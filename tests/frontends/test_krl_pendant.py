@@ -453,15 +453,32 @@ def test_for_loops_with_constant_bounds_are_unrolled() -> None:
 
 
 def test_a_long_loop_still_works() -> None:
+    result = parse(
+        "$VEL.CP = 1",
+        "DECL E6POS p",
+        f"p = {FULL}",
+        "FOR i = 1 TO 10000",
+        "  p.X = i / 100.0",
+        "  LIN p",  # the target depends on the counter: unrolled
+        "ENDFOR",
+    )
+    assert len(list(result.program.motions())) == 10000
+    (unrolled,) = [i for i in result.ignored if i.span.line == 5]
+    assert "written out 10000 times" in unrolled.reason
+
+
+def test_a_loop_whose_body_does_not_depend_on_its_counter_stays_a_loop() -> None:
     result = parse("$VEL.CP = 1", "FOR i = 1 TO 10000", f"  LIN {FULL}", "ENDFOR")
-    assert len(result.program) == 10000
+    (block,) = result.program.instructions
+    assert isinstance(block, ir.For) and len(result.program) == 1 and not result.ignored
 
 
 def test_loop_limits(monkeypatch: pytest.MonkeyPatch) -> None:
     error = parse_error("FOR i = 1 TO 2000000", "ENDFOR")
     assert "2,000,000 times" in error.message and error.span is not None
     monkeypatch.setattr(krl_lower, "MAX_LOWERED_STATEMENTS", 500)
-    error = parse_error("FOR i = 1 TO 100", "  FOR j = 1 TO 100", "  ENDFOR", "ENDFOR")
+    body = ("FOR i = 1 TO 100", "  FOR j = 1 TO 100", "    WAIT SEC i + j", "  ENDFOR", "ENDFOR")
+    error = parse_error(*body)  # the waits depend on the counters: unrolled
     assert "more than 500 statements" in error.message
 
 

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from olp import ir
+from olp.errors import ParseError
 from olp.frontends.krl.ast import (
     Assign,
     Binary,
@@ -80,14 +81,29 @@ _IGNORED_CALLS = {
 class RoutineJumps:
     """The labels of one routine activation and what jumps to them: ``labels`` name -> line,
     ``targets`` name -> the lines of its GOTOs, ``assigned`` the variables the routine assigns
-    anywhere; while lowering: the state each label was reached with (``seen``) and the paths
-    of GOTOs that jump forward to a label not lowered yet (``pending``)."""
+    anywhere; while lowering: the state each label was reached with (``seen``), the paths
+    of GOTOs that jump forward to a label not lowered yet (``pending``) and the states of the
+    GOTOs that jump back (``back_states``); ``first_pass``: those of a first lowering of the
+    routine, so that at a label the settings a later jump back brings are known.
+
+    A first pass is the honest price of jumps back: the label needs the state at a GOTO that
+    is lowered after it. Settings that differ there are ambiguous after the label."""
 
     labels: dict[str, int] = field(default_factory=dict)
     targets: dict[str, list[int]] = field(default_factory=dict)
     assigned: set[str] = field(default_factory=set)
     seen: dict[str, State] = field(default_factory=dict)
     pending: dict[str, list[Any]] = field(default_factory=dict)
+    back_states: dict[str, list[State]] = field(default_factory=dict)
+    first_pass: dict[str, list[State]] = field(default_factory=dict)
+
+    @property
+    def jumps_back(self) -> bool:
+        return any(
+            line > self.labels.get(name, line)
+            for name, lines in self.targets.items()
+            for line in lines
+        )
 
     @classmethod
     def of(cls, body: Sequence[Stmt]) -> RoutineJumps:
@@ -241,6 +257,7 @@ class _Lowering(Motions):
         self.returned, self.exiting, self.loop_depth, self.loops = None, None, 0, []
         self.routine, self.jumped = RoutineJumps.of(routine.body), None
         try:
+            self.first_pass(routine.body)
             self.lower_body(routine.body)
         finally:
             finals = self.variables.pop()
@@ -341,7 +358,27 @@ class _Lowering(Motions):
             )
         if not counts:
             self._ignore(stmt, f"the FOR loop runs 0 times ({start} TO {end} STEP {step})")
+        elif self._lowers_as_block(stmt):
+            self._for_block(stmt)
+            return
+        else:
+            self._ignore(
+                stmt,
+                f"the FOR loop is written out {len(counts)} times: what it does depends on "
+                f"{stmt.counter}, which olp knows only by unrolling it",
+            )
         self._unroll(stmt, counts)
+
+    def _lowers_as_block(self, stmt: ForLoop) -> bool:
+        """Whether the body lowers with the counter unknown (then the loop stays a loop)."""
+        probe = self._child(loop=True, probe=True)
+        unknown = Unknown(f"{stmt.counter} counts the FOR loop at line {stmt.span.line}")
+        probe.variables.assign(stmt.counter.upper(), unknown)
+        try:
+            probe.lower_body(stmt.body)
+        except ParseError:
+            return False
+        return True
 
     def _unroll(self, stmt: ForLoop, counts: range) -> None:
         counter = stmt.counter.upper()
@@ -531,17 +568,8 @@ class _Lowering(Motions):
         name = (stmt.name or "").upper()
         if name not in self.routine.labels:
             raise self._error(f"GOTO {stmt.name}: no label {stmt.name} in this routine", stmt.span)
-        seen = self.routine.seen.get(name)
-        if seen is not None:  # a jump back: the label was lowered with the state it had then
-            differs = [n for n in _STATE_FIELDS if getattr(seen, n) != getattr(self.state, n)]
-            if differs:
-                settings = ", ".join(_SETTING_NAMES[n] for n in differs)
-                raise self._error(
-                    f"GOTO {stmt.name} jumps back to line {self.routine.labels[name]} with other "
-                    f"motion settings ({settings}) than the label was reached with; olp cannot "
-                    "follow that",
-                    stmt.span,
-                )
+        if name in self.routine.seen:  # a jump back: its state is known from the first pass
+            self.routine.back_states.setdefault(name, []).append(self.state)
         else:
             self.routine.pending.setdefault(name, []).append(self._snapshot())
         self.out.append(ir.Goto(label=stmt.name or "", span=stmt.span))
@@ -558,12 +586,28 @@ class _Lowering(Motions):
             self._join_variables(ends, f"the GOTOs to {stmt.name}")
         if any(line > stmt.span.line for line in lines):  # jumped to from below: a loop
             reason = f"{stmt.name} is jumped back to (GOTO at line {max(lines)})"
+            for back in self.routine.first_pass.get(name, []):
+                for field_name in _STATE_FIELDS:
+                    if getattr(back, field_name) != getattr(self.state, field_name):
+                        setting = _SETTING_NAMES[field_name]
+                        self.ambiguous[field_name] = f"{setting} differs where {reason}"
             for var in sorted(self.routine.assigned):
                 self.variables.assign(var, Unknown(f"{var} may change before {reason}"))
             self.track.lose_cartesian(reason)
             self.track.joints, self.track.no_joints = None, reason
         self.routine.seen[name] = self.state
         self.out.append(ir.Label(name=stmt.name or "", span=stmt.span))
+
+    def first_pass(self, body: Sequence[Stmt]) -> None:
+        """Where the routine jumps back, lower it once quietly to learn the states of its
+        backward GOTOs (see :class:`RoutineJumps`)."""
+        if not self.routine.jumps_back:
+            return
+        probe = self._child(probe=True)
+        probe.in_block = self.in_block
+        probe.routine = RoutineJumps.of(body)
+        probe.lower_body(body)
+        self.routine.first_pass = probe.routine.back_states
 
     def _snapshot(self) -> _Lowering:
         snap = self._child(probe=True)
@@ -648,6 +692,7 @@ def lower_module(
     lowering = _Lowering(ctx, State(), variables)
     lowering.routine = RoutineJumps.of(main.body)
     ctx.called.add(main.name.upper())
+    lowering.first_pass(main.body)
     lowering.lower_body(main.body)
     for other in routines[1:]:
         if other.name.upper() not in ctx.called:
