@@ -91,3 +91,15 @@ def test_verbatim_is_one_line() -> None:
         ir.Verbatim(text="$ACC.CP = 2\nPTP {A1 0}", language="krl", span=span)
     with pytest.raises(ir.FlowError, match="statement"):
         ir.Verbatim(text="  ", language="krl")
+
+
+def test_a_motion_to_where_the_robot_is_is_kept_as_written() -> None:
+    from olp.frontends.krl import parse_krl
+
+    result = parse_krl("DEF p( )\nPTP $POS_ACT\nPTP $AXIS_ACT C_PTP\nWAIT SEC 1\nEND\n")
+    kept = [(i.kind, getattr(i, "text", ""), i.span.line) for i in result.program]
+    assert kept == [
+        ("verbatim", "PTP $POS_ACT", 2),
+        ("verbatim", "PTP $AXIS_ACT C_PTP", 3),
+        ("wait", "", 4),
+    ]

@@ -80,6 +80,10 @@ What is lowered
   :class:`~olp.ir.For` block. A jump back to a label makes the variables the routine assigns
   unknown there; one with other motion settings than the label had is an error. ``SPLINE ...
   ENDSPLINE`` blocks are rejected. ``RETURN`` inside a block of an inlined routine is rejected.
+* **Motions to where the robot is** (``PTP $POS_ACT``, ``PTP $AXIS_ACT``: the block
+  coincidence run) are kept as written (:class:`olp.ir.Verbatim`): there is nothing to check.
+  A motion to a value derived from them at run time (``lNow.Z = lNow.Z + 100``, ``LIN lNow``)
+  is an error that says so.
 * **Data.** Declarations in the program are :class:`~olp.ir.Declare`, assignments of the
   program's variables :class:`~olp.ir.Assign` (their constant values are also used, as before);
   what the inline forms assign for BAS (``PDAT_ACT``, ``LDAT_ACT``, ``FDAT_ACT``) is absorbed

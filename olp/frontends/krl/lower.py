@@ -69,6 +69,14 @@ MAX_FOR_ITERATIONS = 1_000_000
 MAX_LOWERED_STATEMENTS = 2_000_000
 """Statements (and loop iterations) lowered in one run, counting every unrolled and inlined copy:
 bounds the time and memory a small file can ask for through nested loops."""
+_HERE = frozenset({"$POS_ACT", "$AXIS_ACT", "$POS_ACT_MES", "$AXIS_ACT_MES"})
+"""Targets that are where the robot stands when the motion starts."""
+
+
+def _is_here(var: Var) -> bool:
+    return not var.selectors and var.name.upper() in _HERE
+
+
 _KEPT_OTHERS = frozenset({"RESUME", "ON_ERROR_PROCEED", "HALT", "BRAKE", "CONTINUE"})
 """Statements that change how the controller runs the program: kept as written."""
 _IGNORED_CALLS = {
@@ -140,7 +148,7 @@ class _Lowering(Motions):
         }
         self._statements: dict[type, Callable[[Any], None]] = {
             FastMotion: self._fast_motion,
-            MotionStmt: self._motion,
+            MotionStmt: self._motion_or_here,
             Assign: self._assign,
             CallStmt: self._call,
             WaitSec: self._wait_sec,
@@ -194,6 +202,17 @@ class _Lowering(Motions):
             self._statements[type(stmt)](stmt)
         except ir.IRError as exc:
             raise self._error(f"invalid value: {exc}", stmt.span) from None
+
+    # ---- motions to where the robot is
+    def _motion_or_here(self, stmt: MotionStmt) -> None:
+        """``PTP $POS_ACT`` / ``PTP $AXIS_ACT`` (the block coincidence run of a program start)
+        move to where the robot already is: nothing to check, kept as written."""
+        target = stmt.targets[-1] if stmt.targets else None
+        simple = stmt.keyword in ("PTP", "SPTP", "LIN", "SLIN") and not stmt.with_clause
+        if simple and isinstance(target, Var) and _is_here(target):
+            self._keep(stmt, f"moves to where the robot already is ({target.name}): no motion")
+        else:
+            self._motion(stmt)
 
     # ---- declarations
     def _decl(self, stmt: Decl) -> None:
