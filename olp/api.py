@@ -134,7 +134,10 @@ def build(
         station = load_station(station)
     notes: tuple[Diagnostic, ...] = ()
     if not isinstance(program, Program):
-        parsed = parse(program, station=station, options=program_options)
+        from olp import progress
+
+        with progress.stage("read"):
+            parsed = parse(program, station=station, options=program_options)
         program, notes = parsed.program, parsed.notes
     elif program_options is not None:
         raise UsageError("program_options are for reading a program file, not an ir.Program")
@@ -143,15 +146,19 @@ def build(
     diagnostics = notes + compiled.diagnostics
     if not compiled.ok:
         return BuildResult(compiled, writer.name, diagnostics)
-    compiled, prepared = writer.prepare(compiled)
+    # The post walks the steps several times: a toolpath's rows are made into steps once here.
+    compiled, prepared = writer.prepare(compiled.flat())
     diagnostics = diagnostics + tuple(prepared) + tuple(writer.check(compiled))
     if has_errors(diagnostics):
         return BuildResult(compiled, writer.name, diagnostics)
-    try:
-        files = writer.render(compiled, name)
-    except RenderError as exc:
-        return BuildResult(compiled, writer.name, diagnostics + exc.diagnostics)
-    written: builtins.list[Path] = []
-    if out_dir is not None:
-        written = writer.write(files, Path(out_dir))
+    from olp import progress
+
+    with progress.stage("write", len(compiled.steps)):
+        try:
+            files = writer.render(compiled, name)
+        except RenderError as exc:
+            return BuildResult(compiled, writer.name, diagnostics + exc.diagnostics)
+        written: builtins.list[Path] = []
+        if out_dir is not None:
+            written = writer.write(files, Path(out_dir))
     return BuildResult(compiled, writer.name, diagnostics, files, tuple(written))

@@ -30,6 +30,7 @@ from olp.ir import Frame, Instruction, LinearPath, Program, Tool, is_motion
 if TYPE_CHECKING:
     from collections.abc import Iterable
 
+    from olp.span import SourceSpan
     from olp.station.model import Station
     from olp.trajectory import Segment, TimeLaw
 
@@ -116,15 +117,18 @@ class PathBlock:
 
 
 class RowTrajectories:
-    """The time laws of a block's rows: row ``k`` is :meth:`segment` ``(k)``, a window of a law
-    (several rows share one law where they are blended into a chain)."""
+    """The time laws of a block's rows: row ``k`` is :meth:`segment` ``(k)``, the window
+    ``start[k]..end[k]`` (s) of law ``laws[law[k]]`` (several rows share one law where they are
+    blended into a chain; ``law[k]`` -1: the row was not timed)."""
 
     def __init__(self, laws: Sequence[TimeLaw], law: IntArray, start: FloatArray, end: FloatArray):
         self.laws, self.law, self.start, self.end = laws, law, start, end
 
-    def segment(self, k: int) -> Segment:
+    def segment(self, k: int) -> Segment | None:
         from olp.trajectory import Segment
 
+        if self.law[k] < 0:
+            return None
         return Segment(self.laws[int(self.law[k])], float(self.start[k]), float(self.end[k]))
 
 
@@ -158,10 +162,14 @@ class StepBlocks(Sequence[Step]):
             return [self[i] for i in range(*index.indices(self._len))]
         if index < 0:
             index += self._len
+        item = self.item_at(index)
+        return item.step(index - item.start) if isinstance(item, PathBlock) else item
+
+    def item_at(self, index: int) -> Item:
+        """The step, or the block, that holds instruction ``index``."""
         if not 0 <= index < self._len:
             raise IndexError(index)
-        item = self.blocks[bisect.bisect_right(self._starts, index) - 1]
-        return item.step(index - item.start) if isinstance(item, PathBlock) else item
+        return self.blocks[bisect.bisect_right(self._starts, index) - 1]
 
     def __iter__(self) -> Iterator[Step]:
         for item in self.blocks:
@@ -177,6 +185,16 @@ def make_steps(items: Sequence[Item]) -> tuple[Step, ...] | StepBlocks:
     if any(isinstance(item, PathBlock) for item in items):
         return StepBlocks(items)
     return tuple(item for item in items if isinstance(item, Step))
+
+
+def span_of(steps: Sequence[Step], index: int) -> SourceSpan:
+    """The source span of instruction ``index``, without making a toolpath row's step."""
+    if isinstance(steps, StepBlocks):
+        item = steps.item_at(index)
+        if isinstance(item, PathBlock):
+            return item.node.row_span(index - item.start)
+        return item.instruction.span
+    return steps[index].instruction.span
 
 
 def items_of(steps: Sequence[Step]) -> tuple[Item, ...]:
@@ -227,6 +245,13 @@ class CompiledProgram:
                 items.append(Step(index=index, instruction=node))
                 index += 1
         return cls(program, station, station.robot.home.copy(), make_steps(items))
+
+    def flat(self) -> CompiledProgram:
+        """A copy whose steps are a tuple, a toolpath's rows made into steps once (for code that
+        walks the steps several times, such as a post's templates)."""
+        if isinstance(self.steps, tuple):
+            return self
+        return dataclasses.replace(self, steps=tuple(self.steps))
 
     def with_diagnostics(self, found: Iterable[Diagnostic]) -> CompiledProgram:
         """A copy with ``found`` appended to the diagnostics."""

@@ -20,6 +20,7 @@ Fields are keyword-only: ``LinearMove(target=..., speed=..., span=...)``.
 from __future__ import annotations
 
 import dataclasses
+import enum
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal, TypeAlias, TypeGuard
@@ -412,13 +413,61 @@ class LinearMove(_Motion):
     kind: Literal["linear"] = field(default="linear", init=False)
 
 
+class ArcOrientation(enum.Enum):
+    """How the tool orientation runs along a circular move (vendor-neutral).
+
+    With ``R0`` the TCP rotation at the start, ``R1`` the target's, ``n`` the circle's normal
+    (right-handed about the direction of travel), ``phi`` the signed sweep and ``t`` in [0, 1]
+    the fraction of the sweep travelled (all in the world; :func:`olp.arcs.arc_rotations`):
+
+    * ``INTERPOLATE``: ``R0 exp(t log(R0^T R1))``, start to end, the via orientation ignored
+      (KUKA ``$ORI_TYPE = #VAR`` with ``$CIRC_TYPE = #BASE``, ABB ``MoveC``, UR ``movec``
+      ``mode=0``);
+    * ``CONSTANT``: ``R0`` throughout, the target's orientation ignored (KUKA ``#CONSTANT`` with
+      ``#BASE``);
+    * ``PATH``: turned with the tangent about ``n`` and the rest of the change to ``R1``
+      interpolated on top (KUKA ``#VAR`` with ``#PATH``);
+    * ``PATH_CONSTANT``: turned with the tangent only, constant relative to it (KUKA
+      ``#CONSTANT`` with ``#PATH``, UR ``movec`` ``mode=1``);
+    * ``WRIST``: the wrist axes interpolated (KUKA ``$ORI_TYPE = #JOINT``): olp cannot plan it
+      (the resolve pass says so on the move's line).
+
+    The sources and their confidence are in :mod:`olp.arcs` and in each post's docstring.
+    """
+
+    INTERPOLATE = "interpolate"
+    CONSTANT = "constant"
+    PATH = "path"
+    PATH_CONSTANT = "path_constant"
+    WRIST = "wrist"
+
+
 @_array_eq
 @dataclass(frozen=True, slots=True, kw_only=True, eq=False)
 class CircularMove(_Motion):
-    """Move the TCP on the circle through ``via`` to ``target`` (KUKA CIRC, ABB MoveC ...)."""
+    """Move the TCP on the circle through the start, ``via`` and ``target`` (KUKA CIRC, ABB
+    MoveC, UR movec, Fanuc C).
+
+    ``via`` and ``target`` are in the motion's frame. ``angle``: the signed sweep in radians
+    (KUKA's ``CA``), or None: the arc ends at ``target``. With an angle the circle is still the
+    one through the three points, but the arc runs ``angle`` from the start (positive: the way
+    of the via point, negative: the other way, beyond a full turn if asked) and ends where that
+    puts it; ``target``'s orientation is reached at that end. ``orientation``: how the tool
+    turns along the arc (:class:`ArcOrientation`). The zone is the arc's approximation at its
+    end, as for a linear move.
+    """
 
     via: CartesianTarget
+    angle: float | None = None
+    orientation: ArcOrientation = ArcOrientation.INTERPOLATE
     kind: Literal["circular"] = field(default="circular", init=False)
+
+    def __post_init__(self) -> None:
+        if self.angle is not None and not (np.isfinite(self.angle) and self.angle != 0.0):
+            raise IRError(f"CircularMove.angle must be finite and not 0 rad, got {self.angle}")
+        if not isinstance(self.orientation, ArcOrientation):
+            found = self.orientation
+            raise IRError(f"CircularMove.orientation must be an ArcOrientation, got {found!r}")
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -27,7 +27,7 @@ import io
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol, overload
 
 import numpy as np
 from numpy.typing import NDArray
@@ -192,6 +192,33 @@ class LineTimeLaw:
         u, ud, udd = self.fraction_state(t)
         line = self.q1 - self.q0
         return self.q0 + u[:, None] * line, ud[:, None] * line, udd[:, None] * line
+
+
+class LineLaws(Sequence[LineTimeLaw]):
+    """Many :class:`LineTimeLaw` as arrays (a toolpath's fine-stopped moves), each law made
+    only when asked for: ``q0``, ``q1`` (M, dof) rad; ``accel`` (M,) 1/s², ``ramp`` and
+    ``total`` (M,) s, as the fields of :class:`LineTimeLaw`."""
+
+    def __init__(
+        self, q0: FloatArray, q1: FloatArray, accel: FloatArray, ramp: FloatArray, total: FloatArray
+    ) -> None:
+        self.q0, self.q1, self.accel, self.ramp, self.total = q0, q1, accel, ramp, total
+
+    def __len__(self) -> int:
+        return int(self.total.size)
+
+    @overload
+    def __getitem__(self, k: int) -> LineTimeLaw: ...
+
+    @overload
+    def __getitem__(self, k: slice) -> Sequence[LineTimeLaw]: ...
+
+    def __getitem__(self, k: int | slice) -> LineTimeLaw | Sequence[LineTimeLaw]:
+        if isinstance(k, slice):
+            return [self[i] for i in range(*k.indices(len(self)))]
+        return LineTimeLaw(
+            self.q0[k], self.q1[k], float(self.accel[k]), float(self.ramp[k]), float(self.total[k])
+        )
 
 
 @dataclass(frozen=True, slots=True, eq=False)

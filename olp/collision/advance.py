@@ -91,16 +91,22 @@ class PathRun:
 
 
 def path_run(
-    paths: Sequence[FloatArray], chain_joints: Callable[[FloatArray], FloatArray]
+    paths: Sequence[FloatArray],
+    chain_joints: Callable[[FloatArray], FloatArray],
+    counts: Sequence[IntArray] | None = None,
 ) -> PathRun:
     """Join motion paths (each (S_k, dof), S_k >= 2, starting where the previous one ends) into a
-    run; ``chain_joints``: the kinematics' controller -> chain map (vectorised)."""
-    counts = np.array([len(p) - 1 for p in paths], dtype=np.int64)
+    run; ``chain_joints``: the kinematics' controller -> chain map (vectorised). ``counts``: per
+    path, its segments per motion when a path holds several motions (a toolpath's rows; they
+    sum to S_k - 1); by default each path is one motion."""
+    if counts is None:
+        counts = [np.array([len(p) - 1], dtype=np.int64) for p in paths]
+    per_motion = np.concatenate(counts).astype(np.int64)
     joints = np.concatenate([paths[0][:1], *(p[1:] for p in paths)], axis=0)
     chain = np.asarray(chain_joints(joints), dtype=np.float64)
-    first = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
-    owner = np.repeat(np.arange(len(paths), dtype=np.int64), counts)
-    return PathRun(joints, chain, owner, first, counts)
+    first = np.concatenate([[0], np.cumsum(per_motion)[:-1]]).astype(np.int64)
+    owner = np.repeat(np.arange(per_motion.size, dtype=np.int64), per_motion)
+    return PathRun(joints, chain, owner, first, per_motion)
 
 
 @dataclass(frozen=True, slots=True)

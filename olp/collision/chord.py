@@ -1,4 +1,4 @@
-"""How far a linear move's joint-space chords stray from its true Cartesian line.
+"""How far a linear (or circular) move's joint-space chords stray from its true Cartesian path.
 
 The collision check proves the piecewise-linear joint path between the resolve pass's samples
 free. A linear move's controller follows the Cartesian line instead, whose joint path between two
@@ -24,7 +24,11 @@ FloatArray = NDArray[np.float64]
 
 
 def chord_deviation(
-    robot: Robot, scene: Scene, paths: Sequence[FloatArray], tool_pose: FloatArray
+    robot: Robot,
+    scene: Scene,
+    paths: Sequence[FloatArray],
+    tool_pose: FloatArray,
+    midpoints: FloatArray | None = None,
 ) -> FloatArray:
     """Midpoint deviation of every segment of linear-move joint paths, metres of point motion.
 
@@ -34,6 +38,9 @@ def chord_deviation(
     scene : its collision scene (which bodies count: links, tool, carried parts).
     paths : joint paths (S_k, dof) rad of linear moves, samples of a straight TCP line.
     tool_pose : (4, 4) the TCP in the flange frame, metres.
+    midpoints : (sum of S_k - 1, 4, 4) the exact TCP poses half way along each segment of
+        another path than a line (a circular move's arc, :func:`olp.arcs.arc_poses` at the
+        half fractions), or None for linear moves.
 
     Returns
     -------
@@ -43,7 +50,10 @@ def chord_deviation(
     """
     starts = np.concatenate([p[:-1] for p in paths])
     ends = np.concatenate([p[1:] for p in paths])
-    exact = _line_midpoints(robot, starts, ends, tool_pose)
+    if midpoints is None:
+        exact = _line_midpoints(robot, starts, ends, tool_pose)
+    else:
+        exact = _nearest_solutions(robot, midpoints @ inv(tool_pose), starts, ends)
     error = np.abs(
         robot.kinematics.chain_joints(exact) - robot.kinematics.chain_joints((starts + ends) / 2)
     )
@@ -61,7 +71,15 @@ def _line_midpoints(
     b = robot.flange_poses(ends) @ tool_pose
     turn = rotation_log(np.swapaxes(a[:, :3, :3], -1, -2) @ b[:, :3, :3])
     middle = pose_from(a[:, :3, :3] @ rotation_exp(turn / 2), (a[:, :3, 3] + b[:, :3, 3]) / 2)
-    solutions = robot.solve(middle @ inv(tool_pose))
+    return _nearest_solutions(robot, middle @ inv(tool_pose), starts, ends)
+
+
+def _nearest_solutions(
+    robot: Robot, flanges: FloatArray, starts: FloatArray, ends: FloatArray
+) -> FloatArray:
+    """Joints (N, dof) reaching the flange poses (N, 4, 4): per row, the solution nearest the
+    midpoint of the joint chord from ``starts`` to ``ends`` (N, dof)."""
+    solutions = robot.solve(flanges)
     chord = (starts + ends) / 2
     # The branch's solution nearest the chord midpoint, every joint unwrapped next to it.
     diff = (solutions - chord[:, None, :] + np.pi) % (2 * np.pi) - np.pi

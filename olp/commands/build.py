@@ -37,21 +37,23 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from olp import progress
     from olp.api import build
     from olp.report import summary
 
     require_files(args.station, args.program)
     check_report_paths(args)
-    result = build(
-        args.station,
-        args.program,
-        post=args.post,
-        out_dir=args.out,
-        name=args.name,
-        options=resolve_options(args),
-        program_options=program_options(args),
-        collisions=collision_options(args),
-    )
+    with progress.showing(progress.terminal_reporter(args.quiet)):
+        result = build(
+            args.station,
+            args.program,
+            post=args.post,
+            out_dir=args.out,
+            name=args.name,
+            options=resolve_options(args),
+            program_options=program_options(args),
+            collisions=collision_options(args),
+        )
     print_diagnostics(result.diagnostics, args.program, quiet=args.quiet)
     write_outputs(args, result)
     if not args.quiet:

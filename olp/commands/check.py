@@ -36,16 +36,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from olp import progress
     from olp.api import BuildResult, compile, load_station
     from olp.report import summary
 
     require_files(args.station, args.program)
     check_report_paths(args)
     station = load_station(args.station)
-    parsed = parse_program(args, station)
-    compiled = compile(
-        parsed.program, station, resolve_options(args), collisions=collision_options(args)
-    )
+    with progress.showing(progress.terminal_reporter(args.quiet)):
+        with progress.stage("read"):
+            parsed = parse_program(args, station)
+        compiled = compile(
+            parsed.program, station, resolve_options(args), collisions=collision_options(args)
+        )
     result = BuildResult(compiled, "-", parsed.notes + compiled.diagnostics)
     print_diagnostics(result.diagnostics, args.program, quiet=args.quiet)
     write_outputs(args, result)

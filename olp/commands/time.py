@@ -74,6 +74,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from olp import progress
     from olp.api import compile, load_station
 
     require_files(args.station, args.program)
@@ -88,14 +89,16 @@ def run(args: argparse.Namespace) -> int:
 
         require_matplotlib()
     station = load_station(args.station)
-    parsed = parse_program(args, station)
-    compiled = compile(
-        parsed.program,
-        station,
-        resolve_options(args),
-        collisions=collision_options(args),
-        other_times=other_times,
-    )
+    with progress.showing(progress.terminal_reporter(args.quiet)):
+        with progress.stage("read"):
+            parsed = parse_program(args, station)
+        compiled = compile(
+            parsed.program,
+            station,
+            resolve_options(args),
+            collisions=collision_options(args),
+            other_times=other_times,
+        )
     print_diagnostics(parsed.notes + compiled.diagnostics, args.program, quiet=args.quiet)
     if not compiled.ok:
         return EXIT_PROGRAM_ERRORS

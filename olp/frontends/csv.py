@@ -64,7 +64,7 @@ from typing import TYPE_CHECKING, BinaryIO
 import numpy as np
 from numpy.typing import NDArray
 
-from olp import ir
+from olp import ir, progress
 from olp.errors import ParseError, UsageError
 from olp.frontends.bundled import ANGLE_UNITS, LENGTH_UNITS
 from olp.frontends.bundled import CsvOptions as CsvOptions  # its home is light to import
@@ -193,6 +193,7 @@ def _lower(stream: CsvStream, name: str, station: Station | None) -> CsvResult:
     builder = _ProgramBuilder(stream, stream.options, station)
     for chunk in stream:
         builder.add(chunk)
+        progress.advance(int(chunk.lines.size))
     return CsvResult(program=builder.program(name), layout=stream.layout, ignored=stream.ignored)
 
 

@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import enum
 import os
 import pickle
 import re
@@ -365,14 +366,18 @@ def _plain(module: str, name: str) -> bool:
 
 
 class _Unpickler(pickle.Unpickler):
-    """Builds only olp's data classes (the IR, the result), numpy arrays and plain data: the
-    result file is written by a process that ran the user's code, so nothing else (no function
-    call, no other class) may come out of it."""
+    """Builds only olp's data classes and enumerations (the IR, e.g. a circular move's
+    :class:`~olp.ir.ArcOrientation`, the result), numpy arrays and plain data: the result file
+    is written by a process that ran the user's code, so nothing else (no function call, no
+    other class) may come out of it. An enumeration is looked up by value, which runs nothing."""
 
     def find_class(self, module: str, name: str) -> Any:
         if module == "olp" or module.startswith("olp."):
             found = super().find_class(module, name)
-            if isinstance(found, type) and dataclasses.is_dataclass(found):
+            olp_type = isinstance(found, type) and (
+                dataclasses.is_dataclass(found) or issubclass(found, enum.Enum)
+            )
+            if olp_type:
                 return found
         elif (module, name) in _NUMPY or _plain(module, name):
             return super().find_class(module, name)

@@ -54,6 +54,8 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 from numpy.typing import NDArray
 
+from olp import progress
+from olp.compiled import PathBlock, Step, items_of
 from olp.diagnostics import Diagnostic
 from olp.errors import UsageError
 from olp.geometry import inv
@@ -63,11 +65,12 @@ from olp.passes.wording import percent
 if TYPE_CHECKING:
     from olp.collision.advance import Hit, Unresolved
     from olp.collision.scene import ConstantPair, Placed, Scene
-    from olp.compiled import CompiledProgram, Step
+    from olp.compiled import CompiledProgram
     from olp.passes.pipeline import BuildOptions
     from olp.station.model import Station
 
 FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
 
 
 @dataclass(frozen=True, slots=True)
@@ -177,6 +180,7 @@ def check_collisions_with_stats(
     stats = CollisionStats()
     for run in runs:
         hits, failed, run_stats = _check_run(run, opts)
+        progress.advance(sum(len(p) if isinstance(p, PathBlock) else 1 for p in run.parts))
         found.extend(hits)
         unresolved.extend(failed)
         stats = CollisionStats(
@@ -194,11 +198,33 @@ def check_collisions_with_stats(
 
 @dataclass(slots=True, eq=False)
 class _Run:
-    """Consecutive resolved motions (joined end to start) in one scene."""
+    """Consecutive resolved motions (joined end to start) in one scene: ordinary steps and whole
+    toolpath blocks (``parts``); ``ordinals``: each part's first motion's ordinal among the
+    program's motions."""
 
     scene: Scene
-    steps: list[Step] = field(default_factory=list)
+    parts: list[Step | PathBlock] = field(default_factory=list)
     ordinals: list[int] = field(default_factory=list)
+
+    def counts(self) -> list[IntArray]:
+        """Per part, the path segments of each of its motions."""
+        return [_segments(part) for part in self.parts]
+
+    def motion(self, m: int) -> tuple[Step, int]:
+        """The step of the run's motion ``m`` and its ordinal (a block's row made only here)."""
+        sizes = np.cumsum([len(part) if isinstance(part, PathBlock) else 1 for part in self.parts])
+        k = int(np.searchsorted(sizes, m, side="right"))
+        part, within = self.parts[k], m - (int(sizes[k - 1]) if k else 0)
+        step = part.step(within) if isinstance(part, PathBlock) else part
+        return step, self.ordinals[k] + within
+
+
+def _segments(part: Step | PathBlock) -> IntArray:
+    if isinstance(part, PathBlock):
+        assert part.ends is not None
+        return np.diff(part.ends, prepend=0).astype(np.int64)
+    assert part.path is not None
+    return np.array([len(part.path) - 1], dtype=np.int64)
 
 
 @dataclass(slots=True, eq=False)
@@ -212,9 +238,53 @@ class _World:
     version: int = 0
 
 
+@dataclass(slots=True, eq=False)
+class _Walk:
+    """Walking the program's motions into runs."""
+
+    compiled: CompiledProgram
+    opts: CollisionOptions
+    world: _World
+    scenes: dict[tuple[object, ...], Scene] = field(default_factory=dict)
+    runs: list[_Run] = field(default_factory=list)
+    unchecked: dict[str, Diagnostic] = field(default_factory=dict)
+    unmet: dict[tuple[str, str], tuple[float, Diagnostic]] = field(default_factory=dict)
+    last: bytes = b""
+    ordinal: int = 0
+
+    def add(self, part: Step | PathBlock) -> None:
+        """Add a motion, or a whole toolpath block, to the runs."""
+        station, world = self.compiled.station, self.world
+        first = part if isinstance(part, Step) else part.start
+        index = first.index if isinstance(first, Step) else first
+        changed = bool(world.pending) and _apply_attachments(index, world, station)
+        ordinal = self.ordinal
+        self.ordinal += len(part) if isinstance(part, PathBlock) else 1
+        path = part.path
+        if path is None or len(path) < 2:
+            self.last = b""
+            return
+        step = part.step(0) if isinstance(part, PathBlock) else part
+        key = _scene_key(step, world)
+        scene = self.scenes.get(key)
+        if scene is None:
+            scene = self.scenes[key] = _scene(station, step, world, self.opts)
+            for label, radius in scene.unchecked:
+                self.unchecked.setdefault(label, _too_far(label, radius, step))
+            _constant_within_clearance(scene, step, self.opts, self.unmet)
+        runs = self.runs
+        if changed or not runs or runs[-1].scene is not scene or path[0].tobytes() != self.last:
+            runs.append(_Run(scene))
+        runs[-1].parts.append(part)
+        runs[-1].ordinals.append(ordinal)
+        self.last = path[-1].tobytes()
+        world.joints = path[-1]
+
+
 def _runs(compiled: CompiledProgram, opts: CollisionOptions) -> tuple[list[_Run], list[Diagnostic]]:
     """The resolved motions in runs: a new run where a motion does not start where the previous
-    one ended, or where the tool or the carried parts change."""
+    one ended, or where the tool or the carried parts change. A toolpath block joins a run whole
+    unless a part is gripped or let go inside it (then row by row)."""
     station = compiled.station
     known = {o.name for o in station.objects}
     world = _World(
@@ -223,33 +293,27 @@ def _runs(compiled: CompiledProgram, opts: CollisionOptions) -> tuple[list[_Run]
         joints=compiled.start_joints,
         pending=[a for a in opts.attachments if a.part in known],
     )
-    scenes: dict[tuple[object, ...], Scene] = {}
-    runs: list[_Run] = []
-    unchecked: dict[str, Diagnostic] = {}
-    unmet: dict[tuple[str, str], tuple[float, Diagnostic]] = {}
-    last = b""
-    motions = (s for s in compiled.steps if is_motion(s.instruction))
-    for ordinal, step in enumerate(motions):
-        changed = bool(world.pending) and _apply_attachments(step.index, world, station)
-        path = step.path
-        if path is None or len(path) < 2:
-            last = b""
-            continue
-        key = _scene_key(step, world)
-        scene = scenes.get(key)
-        if scene is None:
-            scene = scenes[key] = _scene(station, step, world, opts)
-            for label, radius in scene.unchecked:
-                unchecked.setdefault(label, _too_far(label, radius, step))
-            _constant_within_clearance(scene, step, opts, unmet)
-        if changed or not runs or runs[-1].scene is not scene or path[0].tobytes() != last:
-            runs.append(_Run(scene))
-        runs[-1].steps.append(step)
-        runs[-1].ordinals.append(ordinal)
-        last = path[-1].tobytes()
-        world.joints = path[-1]
-    warnings = [d for _, d in unmet.values()]
-    return runs, _unknown_parts(compiled, opts) + list(unchecked.values()) + warnings
+    walk = _Walk(compiled, opts, world)
+    for item in items_of(compiled.steps):
+        if isinstance(item, PathBlock):
+            if _whole(item, world):
+                walk.add(item)
+            else:
+                for k in range(len(item)):
+                    walk.add(item.step(k))
+        elif is_motion(item.instruction):
+            walk.add(item)
+    warnings = [d for _, d in walk.unmet.values()]
+    return walk.runs, _unknown_parts(compiled, opts) + list(walk.unchecked.values()) + warnings
+
+
+def _whole(block: PathBlock, world: _World) -> bool:
+    """Whether a block can join a run whole: resolved, every row with a segment, and no part
+    gripped or let go after its first row."""
+    if block.path is None or block.ends is None or np.any(np.diff(block.ends, prepend=0) < 1):
+        return block.path is None  # unresolved: skipped whole; odd rows: row by row
+    inside = range(block.start + 1, block.stop)
+    return not any(a.grasp in inside or a.release in inside for a in world.pending)
 
 
 def _too_far(label: str, radius: float, step: Step) -> Diagnostic:
@@ -377,9 +441,9 @@ def _bodiless_tools(compiled: CompiledProgram) -> list[Diagnostic]:
     if not any(body.shapes for body in station.tool_bodies.values()):
         return []
     out, seen = [], {FLANGE.name}
-    for step in compiled.steps:
-        tool = step.tool
-        if tool is None or step.joints is None or tool.name in seen:
+    for item in items_of(compiled.steps):
+        tool = item.tool
+        if tool is None or item.joints is None or tool.name in seen:
             continue
         seen.add(tool.name)
         if _station_tool_name(station, tool) not in station.tool_bodies:
@@ -387,6 +451,7 @@ def _bodiless_tools(compiled: CompiledProgram) -> list[Diagnostic]:
                 f"tool {tool.name!r} has no collision geometry in the station (no tool of that "
                 "name, number or TCP): only the robot's links are checked while it is used"
             )
+            step = item.step(0) if isinstance(item, PathBlock) else item
             span = step.instruction.span
             out.append(Diagnostic("warning", "collision_unchecked", msg, span, step.index))
     return out
@@ -440,7 +505,8 @@ def _check_run(
     )
 
     scene = run.scene
-    path = path_run([s.path for s in run.steps if s.path is not None], scene.chain_joints)
+    paths = [part.path for part in run.parts if part.path is not None]
+    path = path_run(paths, scene.chain_joints, run.counts())
     found: list[_Found] = []
     failed: list[Diagnostic] = []
     evaluations = 0
@@ -464,13 +530,13 @@ def _check_run(
             continue
         evaluations += count
         for hit in hits:
-            step, ordinal = run.steps[hit.motion], run.ordinals[hit.motion]
+            step, ordinal = run.motion(hit.motion)
             found.append(_Found(first, second, pair.kind, ordinal, step, hit))
     return found, failed, CollisionStats(evaluations, len(path.joints), len(scene.pairs))
 
 
 def _unresolved(run: _Run, first: str, second: str, exc: Unresolved) -> Diagnostic:
-    step = run.steps[exc.where.motion]
+    step, _ = run.motion(exc.where.motion)
     message = (
         f"{first} against {second} cannot be checked from {percent(exc.where.fraction)} of "
         f"the move on: {exc.reason}"

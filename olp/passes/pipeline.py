@@ -18,6 +18,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
+from olp import progress
 from olp.compiled import CompiledProgram
 from olp.ir import Program
 from olp.passes.collide import CollisionOptions, collision_pass
@@ -69,5 +70,12 @@ def run_passes(
     opts = options or BuildOptions()
     compiled = CompiledProgram.start(program, station)
     for step in passes:
-        compiled = step(compiled, opts)
+        with progress.stage(_stage_name(step), len(compiled.steps)):
+            compiled = step(compiled, opts)
     return compiled
+
+
+def _stage_name(step: Pass) -> str:
+    """How the progress display names a pass: ``resolve_pass`` -> ``resolve``."""
+    name = getattr(step, "__name__", type(step).__name__)
+    return name.removesuffix("_pass")

@@ -5,8 +5,9 @@
 * A Cartesian target of a joint move takes the IK solution (any branch, any ±360° turn variant
   inside the limits) nearest to the previous joints.
 * A linear move must stay in one IK branch: the straight TCP line is sampled (``step_m``,
-  ``step_rad``), solved in the branch of the start joints (on a singularity, the branch that
-  meets it there and continues it) and unwrapped continuously. Leaving the
+  ``step_rad``; a circular move its arc, :func:`_arc_path`), solved in the branch of the start
+  joints (on a singularity, the branch that meets it there and continues it) and unwrapped
+  continuously. Leaving the
   workspace, a joint limit, or a joint jump between samples (a singularity or a configuration
   flip) is an error on that instruction; so is a move that needs more samples than one check
   takes (:data:`olp.passes.sampling.MAX_SAMPLES`), counted before any is made. A path that
@@ -26,11 +27,14 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from olp import progress
+from olp.arcs import ArcError, arc_rotations, circle_through, rotation_travel, sample_count
 from olp.compiled import CompiledProgram, Item, PathBlock, Step, StepBlocks, make_steps
 from olp.diagnostics import Diagnostic
-from olp.geometry import interpolate_poses, inv, pose_distance
+from olp.geometry import interpolate_poses, inv, pose_distance, pose_from
 from olp.ir import (
     MOTION_TYPES,
+    ArcOrientation,
     CartesianTarget,
     CircularMove,
     Configuration,
@@ -62,7 +66,8 @@ IntArray = NDArray[np.int64]
 class ResolveOptions:
     """Settings of the resolve pass.
 
-    ``step_m`` / ``step_rad``: sampling of linear moves (TCP travel and rotation per sample).
+    ``step_m`` / ``step_rad``: sampling of linear and circular moves (TCP travel and rotation
+    per sample); ``step_arc_rad``: most angle of a circular move's arc per sample.
     ``max_joint_step_rad``: a larger joint change between two samples is reported as a
     discontinuity (singularity or configuration flip). ``weights``: per-joint weights of the
     distance used to choose the nearest IK solution.
@@ -76,6 +81,8 @@ class ResolveOptions:
 
     step_m: float = 0.005
     step_rad: float = np.radians(2.0)
+    # 2° of arc: the chord sags 0.015% of the radius below the circle (path lengths 5e-5 short).
+    step_arc_rad: float = np.radians(2.0)
     max_joint_step_rad: float = np.radians(15.0)
     weights: tuple[float, ...] = (1.0, 1.0, 1.0, 1.0, 1.0, 1.0)
     fallback_joint: bool = False
@@ -110,6 +117,7 @@ def resolve(
             items.extend(found_items)
             diags.extend(found)
             index, flat = index + 1, flat + len(node)
+            progress.advance(len(node))
             continue
         run = _linear_run(nodes, index, flat, station)
         if run:
@@ -117,6 +125,7 @@ def resolve(
             items.extend(found_items)
             diags.extend(found)
             index, flat = index + len(run), flat + len(run)
+            progress.advance(len(run))
             continue
         if isinstance(node, MOTION_TYPES):
             step, found = _resolve_motion(flat, node, station, state)
@@ -125,6 +134,7 @@ def resolve(
         else:
             items.append(Step(index=flat, instruction=node))
         index, flat = index + 1, flat + 1
+        progress.advance(1)
     steps = make_steps(items)
     if isinstance(steps, StepBlocks) and not program.has_flow:
         program = program.replace_instructions([_node_of(item) for item in steps.blocks])
@@ -478,6 +488,7 @@ def _singular_warnings(
     ends: IntArray,
     fractions: FloatArray,
     state: _State,
+    move: str = "linear move",
 ) -> list[Diagnostic]:
     """Warn where a resolved linear path starts, ends or passes at a singular pose.
 
@@ -538,7 +549,7 @@ def _singular_warnings(
                 Diagnostic(
                     "warning",
                     "singularity",
-                    f"linear move {first + lo} {verb} the {name} singularity ({text}): "
+                    f"{move} {first + lo} {verb} the {name} singularity ({text}): "
                     f"{undefined}, so the controller may stop the move there or take other "
                     f"joint values than olp planned{also}",
                     moves.span(lo),
@@ -603,9 +614,8 @@ def _resolve_motion(
     if tool is None or frame is None:
         return Step(index=index, instruction=ins, tool=tool, frame=frame), diags
     if isinstance(ins, CircularMove):
-        diags.append(_error("unsupported", "circular moves are not resolved yet", index, ins))
-        return Step(index=index, instruction=ins, tool=tool, frame=frame), diags
-    if isinstance(ins, LinearMove):
+        path, found = _arc_path(index, ins, tool, frame, state)
+    elif isinstance(ins, LinearMove):
         path, found = _linear_path(index, ins, tool, frame, state)
     else:
         path, found = _joint_path(index, ins, tool, frame, state)
@@ -623,7 +633,7 @@ _UNREACHABLE = frozenset({"unreachable", "joint_limit"})
 
 def _recover(
     index: int,
-    ins: JointMove | LinearMove,
+    ins: JointMove | LinearMove | CircularMove,
     tool: Tool,
     frame: Frame,
     state: _State,
@@ -667,7 +677,7 @@ def _recover(
 
 
 def _restart_at_target(
-    ins: JointMove | LinearMove, tool: Tool, frame: Frame, state: _State
+    ins: JointMove | LinearMove | CircularMove, tool: Tool, frame: Frame, state: _State
 ) -> None:
     """After a failed move, check the next one from the target itself (nearest IK solution) so
     that one bad move does not make every following move fail too."""
@@ -815,10 +825,45 @@ def _linear_path(
     fractions = np.linspace(0.0, 1.0, count + 1)
     flanges = interpolate_poses(tcp_start, tcp_end, fractions) @ inv(tool.pose)
     sols = _branch_path(robot, state.q, robot.solve(flanges, seed=state.q))
+    path, failed = _checked_path(index, ins, sols, fractions, dist / count, state, _LINE)
+    if path is None:
+        return None, failed
+    ends = np.array([count], dtype=np.int64)
+    one = _Run(
+        first=index,
+        poses=np.asarray(end)[None],
+        frame_poses=np.eye(4)[None],
+        speeds=np.array([ins.speed.linear]),
+        tool=tool,
+        frames=(frame,),
+        moves=(ins,),
+    )
+    return path, _singular_warnings(one, path, ends, fractions, state)
+
+
+_LINE = ("the straight line", "linear move")
+_ARC = ("the arc", "circular move")
+
+
+def _checked_path(
+    index: int,
+    ins: Instruction,
+    sols: FloatArray,
+    fractions: FloatArray,
+    spacing: float,
+    state: _State,
+    words: tuple[str, str],
+) -> tuple[FloatArray | None, list[Diagnostic]]:
+    """The IK solutions (S, 6) of one branch along a sampled Cartesian path, unwrapped from
+    ``state.q``, or the error where they leave the workspace, a joint limit, or jump by more
+    than ``max_joint_step_rad`` between samples ``spacing`` m apart (a singularity or a
+    configuration flip). ``words``: how the messages name the path and the move."""
+    robot = state.robot
+    shape, move = words
     if np.any(~np.isfinite(sols)):
         first = int(np.argmax(~np.all(np.isfinite(sols), axis=-1)))
         msg = (
-            f"the straight line leaves the robot's workspace at "
+            f"{shape} leaves the robot's workspace at "
             f"{wording.percent(fractions[first])} of the move"
             " (in the configuration the move starts in)"
         )
@@ -834,22 +879,116 @@ def _linear_path(
         joint = int(np.argmax(jumps[row]))
         msg = (
             f"axis {joint + 1} would turn {np.degrees(jumps[row, joint]):.1f}° within "
-            f"{wording.quantity(dist / count * 1000)} mm at {wording.percent(fractions[row])} "
-            "of the linear move: it passes through or near a singularity"
+            f"{wording.quantity(spacing * 1000)} mm at {wording.percent(fractions[row])} "
+            f"of the {move}: it passes through or near a singularity"
         )
         hint = "use a joint move, or change the tool orientation to avoid the singular pose"
         return None, [_error("singularity", msg, index, ins, joints=path[row], hint=hint)]
-    ends = np.array([count], dtype=np.int64)
+    return path, []
+
+
+def _arc_path(
+    index: int, ins: CircularMove, tool: Tool, frame: Frame, state: _State
+) -> tuple[FloatArray | None, list[Diagnostic]]:
+    """A circular move in one IK branch: the arc (:mod:`olp.arcs`) from the TCP where the robot
+    is, past the via point, to the target (or through the circular angle) sampled every
+    ``step_m`` of travel, ``step_rad`` of tool turn and ``step_arc_rad`` of arc, the tool
+    turning by the move's orientation rule, then checked as a linear move is (workspace,
+    limits, joint jumps, singular poses, the joint speed the programmed TCP speed needs).
+    Degenerate arcs and an orientation rule olp cannot plan are errors on the move."""
+    robot, opts = state.robot, state.opts
+    assert tool.pose is not None and frame.pose is not None
+    if ins.orientation is ArcOrientation.WRIST:
+        msg = (
+            "the arc's orientation follows the wrist axes (KUKA $ORI_TYPE #JOINT): olp plans "
+            "circular moves only with a Cartesian orientation rule"
+        )
+        hint = "set $ORI_TYPE = #VAR or #CONSTANT before the arc"
+        return None, [_error("unsupported", msg, index, ins, hint=hint)]
+    start = robot.flange_poses(state.q) @ tool.pose
+    end = _arc_end(index, ins, tool, frame, state)
+    if isinstance(end, Diagnostic):
+        return None, [end]
+    via = frame.pose @ ins.via.pose
+    try:
+        arc = circle_through(start[:3, 3], via[:3, 3], end[:3, 3], ins.angle)
+    except ArcError as exc:
+        return None, [_error("degenerate_arc", f"circular move: {exc}", index, ins)]
+    turn = rotation_travel(start[:3, :3], end[:3, :3], arc, ins.orientation)
+    wanted = sample_count(arc, turn, opts.step_m, opts.step_rad, opts.step_arc_rad)
+    if not wanted <= MAX_SAMPLES:
+        msg = (
+            f"the arc is too long to check: {wording.quantity(arc.length * 1000)} mm over "
+            f"{wording.quantity(np.degrees(abs(arc.sweep)))}° needs {wanted:.4g} samples, more "
+            f"than the {MAX_SAMPLES} one move may have"
+        )
+        return None, [_error("too_long", msg, index, ins)]
+    count = int(wanted)
+    fractions = np.linspace(0.0, 1.0, count + 1)
+    rotations = arc_rotations(start[:3, :3], end[:3, :3], arc, fractions, ins.orientation)
+    flanges = pose_from(rotations, arc.points(fractions)) @ inv(tool.pose)
+    sols = _branch_path(robot, state.q, robot.solve(flanges, seed=state.q))
+    spacing = arc.length / count
+    path, failed = _checked_path(index, ins, sols, fractions, spacing, state, _ARC)
+    if path is None:
+        return None, failed
     one = _Run(
         first=index,
-        poses=np.asarray(end)[None],
+        poses=flanges[-1:] @ tool.pose,
         frame_poses=np.eye(4)[None],
         speeds=np.array([ins.speed.linear]),
         tool=tool,
         frames=(frame,),
-        moves=(ins,),
     )
-    return path, _singular_warnings(one, path, ends, fractions, state)
+    found = _singular_warnings(one, path, np.array([count]), fractions, state, _ARC[1])
+    found += _arc_speed_warning(index, ins, path, spacing, robot)
+    return path, found
+
+
+def _arc_end(
+    index: int, ins: CircularMove, tool: Tool, frame: Frame, state: _State
+) -> FloatArray | Diagnostic:
+    """The arc's programmed end as a TCP pose (4, 4) in the world, or the error of a target
+    that cannot be reached (a joint target's values, or no IK solution for a Cartesian one
+    that the arc ends at)."""
+    robot = state.robot
+    assert tool.pose is not None and frame.pose is not None
+    if isinstance(ins.target, JointTarget):
+        bad = _joint_target_error(index, ins, ins.target, robot)
+        if bad is not None:
+            return bad
+        tcp: FloatArray = robot.flange_poses(ins.target.joints) @ tool.pose
+        return tcp
+    flange = flange_target(ins.target, tool, frame)
+    if ins.angle is None and _candidates(robot, flange).shape[0] == 0:
+        return _unreachable(index, ins, robot, flange)
+    return flange @ tool.pose
+
+
+def _arc_speed_warning(
+    index: int, ins: CircularMove, path: FloatArray, spacing: float, robot: Robot
+) -> list[Diagnostic]:
+    """Warn where the programmed TCP speed needs a joint faster than its limit along an arc
+    sampled every ``spacing`` m (as :func:`_speed_warnings` does for linear moves)."""
+    if spacing <= 0.0:
+        return []
+    needed = np.abs(np.diff(path, axis=0)) * (ins.speed.linear / spacing)
+    ratio = needed / robot.limits.velocity
+    if not np.max(ratio) > 1.0 + 1e-9:
+        return []
+    row, joint = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
+    need, limit = wording.above(
+        float(np.degrees(needed[row, joint])), float(np.degrees(robot.limits.velocity[joint]))
+    )
+    msg = (
+        f"move {index}: {wording.quantity(ins.speed.linear * 1000, 0)} mm/s needs axis "
+        f"{int(joint) + 1} at {need}°/s (limit {limit}°/s); the TCP will be slower there"
+    )
+    hint = "lower the speed, or keep the path away from singular poses"
+    diag = Diagnostic(
+        "warning", "speed_limited", msg, ins.span, index, joints=path[row + 1], hint=hint
+    )
+    return [diag]
 
 
 def _joint_target_error(

@@ -21,6 +21,10 @@ the confidence given:
   1000]``) and zonedata ``z0 .. z200`` (:data:`PREDEFINED_ZONES`): medium-high confidence.
 * Moves: ``MoveAbsJ jointtarget\\NoEOffs, speed, zone, tool;`` for joint targets, ``MoveJ`` /
   ``MoveL`` / ``MoveC via, to`` with robtargets and ``\\WObj:=`` (left out for ``wobj0``).
+  ``MoveC`` interpolates the tool orientation from the start to the ``ToPoint`` and does not
+  reach the ``CirPoint``'s (RAPID reference, ``MoveC``, as remembered: medium confidence, not
+  found in a stored source): only :attr:`~olp.ir.ArcOrientation.INTERPOLATE` is written, no
+  circular angle (the base post's ``arc_orientation`` / ``arc_angle`` errors).
   ``ConfJ \\On`` / ``ConfL \\On`` make the controller take the written confdata. Joint moves are
   limited by the speeddata's TCP speed: RAPID has no joint speed fraction (warned).
 * ``SetDO signal, 0|1;``, ``WaitDI signal, 0|1;`` (I/O by configured signal name:
@@ -50,11 +54,13 @@ from olp.diagnostics import Diagnostic
 from olp.errors import PostError
 from olp.posts.base import Filter, Post
 from olp.posts.numbers import NumberFormat, Storage
+from olp.posts.sandbox import SafeText
 from olp.posts.text import IDENTIFIER, NUMBER, ArgumentRule, NameRule, one_of
 from olp.vendors.abb import confdata, normalised_rounded, pose_to_robtarget
 
 if TYPE_CHECKING:
     from olp.compiled import CompiledProgram, Step
+    from olp.posts.rows import PostRows
     from olp.posts.view import PostFrame, PostStep, PostTool
 
 QUATERNION_DECIMALS = 9
@@ -221,6 +227,45 @@ def rapid_signal(post: Post, index: int, pattern: str) -> str:
     return name
 
 
+def rapid_rows_data(post: Post, rows: PostRows) -> SafeText:
+    """The robtarget declarations of a run of MoveL (:mod:`olp.posts.rows`), exactly as
+    ``module.mod.j2`` writes each (``LOCAL CONST robtarget p12 := [..];``): positions and
+    quaternions formatted as columns. Names are legal identifiers and numbers are checked, so
+    the lines are :class:`~olp.posts.sandbox.SafeText`."""
+    steps = rows.steps
+    trans, rot = pose_to_robtarget(rows.poses())
+    xyz = post.number_column("position", trans, steps)
+    quat = post.number_column("quaternion", normalised_rounded(rot, QUATERNION_DECIMALS), steps)
+    extax = ",".join([EXTERNAL_AXIS_UNUSED] * 6)
+    lines = []
+    for k, step in enumerate(steps):
+        p, q = 3 * k, 4 * k
+        pose = f"[{xyz[p]},{xyz[p + 1]},{xyz[p + 2]}],[{','.join(quat[q : q + 4])}]"
+        conf = rapid_confdata(step.vendor["confdata"])
+        lines.append(f"  LOCAL CONST robtarget {step.name} := [{pose},{conf},[{extax}]];")
+    return SafeText("\n".join(lines))
+
+
+def rapid_rows(post: Post, rows: PostRows) -> SafeText:
+    """The moves of a run of MoveL (:mod:`olp.posts.rows`), exactly as ``module.mod.j2``
+    writes each: ``MoveL p12, v100, z10, tool\\WObj:=wobj;`` (speed and zone data names
+    computed once per distinct value)."""
+    names: dict[Any, str] = {}
+    lines = []
+    for step in rows.steps:
+        post.current_step = step
+        speed = names.get(step.speed)
+        if speed is None:
+            speed = names[step.speed] = speed_name(post, step.speed)
+        zone = names.get(step.zone)
+        if zone is None:
+            zone = names[step.zone] = zone_name(post, step.zone)
+        wobj = "" if step.frame_name == "wobj0" else "\\WObj:=" + step.frame_name
+        lines.append(f"    MoveL {step.name}, {speed}, {zone}, {step.tool_name}{wobj};")
+    post.current_step = rows
+    return SafeText("\n".join(lines))
+
+
 def _robtarget_filter(post: Post, joints: ArrayLike, robot: Any, pose: ArrayLike) -> str:
     """Template filter: ``joints | rapid_robtarget(robot, pose)``."""
     return rapid_robtarget(post, pose, confdata(robot, joints))
@@ -243,6 +288,8 @@ FILTERS: Mapping[str, Filter] = {
     "rapid_speed": speed_name,
     "rapid_zone": zone_name,
     "rapid_signal": rapid_signal,
+    "rapid_rows_data": rapid_rows_data,
+    "rapid_rows": rapid_rows,
 }
 
 
@@ -252,6 +299,7 @@ class AbbPost(Post):
     NAME = "abb"
     VENDOR = "abb"
     LANGUAGE = "RAPID"
+    ROWS = True
     NAME_RULE = NAME_RULE
     CALL_ARGUMENTS = ArgumentRule(
         one_of(NUMBER, r'"[^"\\\x00-\x1f\x7f-\x9f\u2028\u2029]{0,80}"', IDENTIFIER),

@@ -48,6 +48,7 @@ from numpy.typing import NDArray
 
 from olp.diagnostics import Diagnostic
 from olp.errors import PostError
+from olp.ir import ArcOrientation
 from olp.posts.numbers import NumberError, NumberFormat, format_number, format_numbers
 from olp.posts.sandbox import PostSandbox, make_environment
 from olp.posts.text import (
@@ -63,6 +64,7 @@ from olp.posts.text import (
 if TYPE_CHECKING:
     from olp.compiled import CompiledProgram, Step
     from olp.posts.manifest import PostManifest
+    from olp.posts.rows import PostRows
     from olp.posts.view import PostStep
 
 FloatArray = NDArray[np.float64]
@@ -152,10 +154,19 @@ class Post:
     """The controller's own name for its reference frame."""
     PREDEFINED_NAMES: ClassVar[frozenset[str]] = frozenset()
     """Names the controller defines: generated data never take them."""
+    ARC_ORIENTATIONS: ClassVar[frozenset[ArcOrientation]] = frozenset({ArcOrientation.INTERPOLATE})
+    """The orientation rules of circular moves this language can write (the three-point arc
+    interpolating start to end, unless a brand says otherwise); any other is an error on the
+    move's line, never a different path."""
+    ARC_ANGLE: ClassVar[bool] = False
+    """Whether a circular move's circular angle (KUKA's CA) can be written."""
+    ROWS: ClassVar[bool] = False
+    """Whether the post writes runs of linear moves with a row writer (:mod:`olp.posts.rows`);
+    used only where the template folder says ``rows: true`` and :meth:`rows_enabled` agrees."""
 
     def __init__(self, manifest: PostManifest) -> None:
         self.manifest = manifest
-        self.current_step: PostStep | None = None
+        self.current_step: PostStep | PostRows | None = None
         self.problems: list[Diagnostic] = []
         self.collecting = False
         """While rendering: numbers that cannot be written are collected as diagnostics on the
@@ -205,6 +216,7 @@ class Post:
         out = self._foreign_robot(compiled)
         if compiled.program.has_flow and not self.WRITES_FLOW:
             return [*out, self._flow_error(compiled)]
+        compiled = compiled.flat()
         for step in compiled.steps:
             out += self._shared_checks(step)
             out += self.check_instruction(step, compiled)
@@ -216,7 +228,8 @@ class Post:
         it is), so the text never depends on whether the caller prepared the program."""
         from olp.posts.render import render
 
-        return render(self.prepare(compiled)[0], self, name)
+        # The templates walk the steps row by row several times: make a toolpath's rows once.
+        return render(self.prepare(compiled)[0].flat(), self, name)
 
     def write(self, files: Mapping[str, str], folder: Path) -> list[Path]:
         """Encode every file in the manifest's encoding (a character it lacks is a PostError
@@ -252,6 +265,36 @@ class Post:
         """``value`` in the printed unit of ``quantity`` (``NUMBERS``), checked; a value that
         cannot be written becomes an error on the instruction being written."""
         return self.number_with(self.NUMBERS[quantity], value)
+
+    def number_column(self, quantity: str, values: Any, steps: Sequence[PostStep]) -> list[str]:
+        """:meth:`number` for values (n, k) or (n,), row r belonging to ``steps[r]``: spelled and
+        checked as one column (:func:`~olp.posts.numbers.format_numbers`); a value that cannot
+        be written is an error on its own row's instruction. Row-major, n * k texts."""
+        v = np.asarray(values, dtype=np.float64)
+        fmt = self.NUMBERS[quantity]
+        try:
+            return format_numbers(v, fmt)
+        except NumberError:
+            pass
+        saved, out = self.current_step, []
+        per_row = v.reshape(len(steps), -1)
+        for step, row in zip(steps, per_row, strict=True):
+            self.current_step = step
+            out += [self.number_with(fmt, float(x)) for x in row]
+        self.current_step = saved
+        return out
+
+    def rows_enabled(self) -> bool:
+        """Whether runs of linear moves go to the row writer: the post has one, the template
+        folder declares ``rows: true``, and (per brand) the options allow it."""
+        return self.ROWS and self.manifest.rows
+
+    def group(self, steps: Sequence[PostStep]) -> list[PostStep | PostRows]:
+        """A file's steps as its templates see them (:func:`olp.posts.rows.group_rows` where
+        :meth:`rows_enabled`)."""
+        from olp.posts.rows import group_rows
+
+        return group_rows(steps) if self.rows_enabled() else list(steps)
 
     def numbers(self, quantity: str, values: Any) -> list[str]:
         """:meth:`number` for an array of values (N,)."""
@@ -316,7 +359,29 @@ class Post:
             return self._call_checks(step, ins.name, ins.args)
         if kind in ("set_output", "wait_input"):
             return self._io_checks(step, kind, ins.index)
+        if kind == "circular":
+            return self._arc_checks(step, ins)
         return []
+
+    def _arc_checks(self, step: Step, ins: Any) -> list[Diagnostic]:
+        """A circular move whose orientation rule or circular angle this language cannot
+        write (:attr:`ARC_ORIENTATIONS`, :attr:`ARC_ANGLE`)."""
+        out = []
+        if ins.orientation not in self.ARC_ORIENTATIONS:
+            can = ", ".join(sorted(o.value for o in self.ARC_ORIENTATIONS))
+            msg = (
+                f"the {self.LANGUAGE} post cannot write a circular move whose orientation rule is "
+                f"{ins.orientation.value!r} (it writes: {can})"
+            )
+            out.append(_error("arc_orientation", msg, step))
+        if ins.angle is not None and not self.ARC_ANGLE:
+            msg = (
+                f"the {self.LANGUAGE} post cannot write a circular angle (CA): the arc would "
+                "end at its programmed end point instead"
+            )
+            hint = "program the arc's real end point (and a second arc beyond 180°) instead"
+            out.append(_error("arc_angle", msg, step, hint=hint))
+        return out
 
     def _comment_checks(self, step: Step, text: str) -> list[Diagnostic]:
         try:

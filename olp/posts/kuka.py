@@ -16,8 +16,13 @@ files ``tests/golden/kuka/``.
 * Targets: ``E6POS`` ``{X,Y,Z,A,B,C,S,T}`` (mm, deg, S and T decimal as the pendant writes them
   in .dat files) for Cartesian targets, ``E6AXIS`` ``{A1..A6}`` (deg) for joint targets; inline
   aggregates or named points ``DECL E6POS XP1={..}`` in the .dat (the pendant's naming);
-  ``CIRC aux, end``. External axes E1..E6 are not written: on a robot without them they mean
-  nothing, and a written 0 would move an axis that exists.
+  ``CIRC aux, end`` (``, CA angle`` in degrees when the move has a circular angle), with
+  ``$ORI_TYPE``/``$CIRC_TYPE`` written before an arc whose rule differs from the last written
+  (:data:`olp.vendors.kuka.ARC_TYPES`; the first arc always writes both) and ``$ORI_TYPE =
+  #VAR`` again before the next LIN (olp's LIN interpolates the orientation). KRL writes every
+  rule but the wrist one (:attr:`KukaPost.ARC_ORIENTATIONS`). External axes E1..E6 are not
+  written: on a robot without them they mean nothing, and a written 0 would move an axis that
+  exists.
 * ``$TOOL``/``$BASE``: ``{FRAME: ..}`` or ``TOOL_DATA[1..16]``/``BASE_DATA[1..32]`` (the arrays
   of ``$config.dat``); ``$NULLFRAME`` for no tool / the world. ``$BASE`` is relative to
   ``$WORLD``.
@@ -46,17 +51,19 @@ from numpy.typing import ArrayLike
 
 from olp.diagnostics import Diagnostic
 from olp.errors import PostError
-from olp.ir import CartesianTarget
+from olp.ir import ArcOrientation, CartesianTarget
 from olp.ir_flow import FLOW_TYPES, leaves_and_blocks
 from olp.posts.base import Filter, Post
 from olp.posts.kuka_flow import flow_problem, krl_decl, krl_expr
 from olp.posts.numbers import NumberFormat, Storage
+from olp.posts.sandbox import SafeText
 from olp.posts.text import IDENTIFIER, NUMBER, ArgumentRule, NameRule, double_quoted, one_of
-from olp.vendors.kuka import pose_to_frame, status_turn, turn_ambiguous
+from olp.vendors.kuka import ARC_TYPES, pose_to_frame, status_turn, turn_ambiguous
 
 if TYPE_CHECKING:
     from olp.compiled import CompiledProgram, Step
-    from olp.posts.view import PostStep
+    from olp.posts.rows import PostRows
+    from olp.posts.view import Modal, PostStep
 
 _KEYWORDS = """
 AND ANIN ANOUT B_AND B_EXOR B_NOT B_OR BOOL BRAKE C_DIS C_ORI C_PTP C_VEL CASE CHAR CIRC
@@ -191,6 +198,60 @@ def whole_percent(fraction: float) -> int:
     return math.floor(float(fraction) * 100.0 + 1e-9)
 
 
+def krl_arc_types(post: Post, step: PostStep) -> tuple[str, str]:
+    """``($ORI_TYPE, $CIRC_TYPE)`` without ``#`` of a circular move's orientation rule."""
+    ins: Any = step.instruction
+    return ARC_TYPES[ins.orientation]
+
+
+def krl_ca(post: Post, step: PostStep) -> str:
+    """``, CA 90.0000`` for a circular move with a circular angle (degrees), else ''."""
+    angle = getattr(step.instruction, "angle", None)
+    return "" if angle is None else f", CA {post.number('angle', math.degrees(angle))}"
+
+
+def krl_rows(post: Post, rows: PostRows, modal: Modal, arcs_written: bool = False) -> SafeText:
+    """The lines of a run of LINs (:mod:`olp.posts.rows`), exactly as ``program.src.j2`` writes
+    each (inline points): ``$BASE``/``$TOOL`` where they change, ``$VEL.CP`` (and ``$VEL.ORI``)
+    where the speed changes, ``$APO.CDIS`` where the approximation distance changes (``modal``),
+    ``$ORI_TYPE = #VAR`` after an arc (``arcs_written``), then ``LIN {E6POS} [C_DIS]``. The
+    targets' numbers are formatted as columns. Every piece is a checked number, a legal name or
+    a keyword, so the lines are :class:`~olp.posts.sandbox.SafeText`."""
+    steps = rows.steps
+    n = len(steps)
+    frames = pose_to_frame(rows.poses())
+    xyz = post.number_column("position", frames[:, :3], steps)
+    abc = post.number_column("angle", frames[:, 3:], steps)
+    mode = str(post.options.get("frames", "inline"))
+    lines: list[str] = []
+    for k, step in enumerate(steps):
+        post.current_step = step
+        if step.new_frame:
+            lines.append(f"$BASE = {krl_base(post, step, mode)} ; {step.frame_name}")
+        if step.new_tool:
+            lines.append(f"$TOOL = {krl_tool(post, step, mode)} ; {step.tool_name}")
+        speed, zone = step.speed, step.zone
+        if step.new_linear_speed:
+            lines.append(f"$VEL.CP = {post.number('vel_cp', speed.linear)}")
+            if speed.angular is not None:
+                ori = post.number("vel_ori", math.degrees(speed.angular))
+                lines += [f"$VEL.ORI1 = {ori}", f"$VEL.ORI2 = {ori}"]
+        fine = zone.is_fine
+        if not fine and modal.changed("cdis", zone.radius):
+            lines.append(f"$APO.CDIS = {post.number('cdis', zone.radius * 1000)}")
+        if arcs_written and modal.changed("ori_type", "VAR"):
+            lines.append("$ORI_TYPE = #VAR")
+        p, o = 3 * k, 3 * k
+        target = (
+            f"X {xyz[p]},Y {xyz[p + 1]},Z {xyz[p + 2]},A {abc[o]},B {abc[o + 1]},C {abc[o + 2]}"
+            f",S {int(step.vendor['status'])},T {int(step.vendor['turn'])}"
+        )
+        lines.append(f"LIN {{{target}}}" + ("" if fine else " C_DIS"))
+    post.current_step = rows
+    assert len(xyz) == len(abc) == 3 * n
+    return SafeText("\n".join(lines))
+
+
 def _is_identity(pose: ArrayLike) -> bool:
     return bool(np.allclose(pose, np.eye(4), rtol=0.0, atol=1e-12))
 
@@ -217,6 +278,9 @@ FILTERS: Mapping[str, Filter] = {
     "krl_tool": krl_tool,
     "krl_base": krl_base,
     "krl_percent": krl_percent,
+    "krl_arc_types": krl_arc_types,
+    "krl_ca": krl_ca,
+    "krl_rows": krl_rows,
     "krl_expr": lambda post, expr: krl_expr(expr),
     "krl_decl": lambda post, step: krl_decl(step),
 }
@@ -238,6 +302,14 @@ class KukaPost(Post):
     )
     NUMBERS: ClassVar[Mapping[str, NumberFormat]] = NUMBERS
     FILTERS: ClassVar[Mapping[str, Filter]] = FILTERS
+    ARC_ORIENTATIONS = frozenset(ARC_TYPES) - {ArcOrientation.WRIST}
+    ARC_ANGLE = True
+    ROWS = True
+
+    def rows_enabled(self) -> bool:
+        """Runs of LINs go to :func:`krl_rows` with inline points (named points also need their
+        declarations in the .dat, which its template writes per motion)."""
+        return super().rows_enabled() and self.options.get("points", "inline") == "inline"
 
     def step_values(self, robot: Any, joints: Any) -> list[Mapping[str, Any]]:
         """Status and Turn of each motion's planned joints (N, 6) rad, and whether Turn cannot

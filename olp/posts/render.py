@@ -48,9 +48,11 @@ from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from olp import progress
 from olp.diagnostics import Diagnostic
 from olp.errors import PostError
 from olp.posts.flow import weave
+from olp.posts.rows import PostRows
 from olp.posts.text import basename
 from olp.posts.view import Allocation, Modal, Names, PostFrame, PostStep, PostTool, ProgramView
 from olp.transforms.split import SplitLimits, part_names, split_steps
@@ -68,14 +70,14 @@ class RenderError(Exception):
         self.diagnostics = tuple(diagnostics)
 
 
-class TrackedSteps(list[PostStep]):
+class TrackedSteps(list[PostStep | PostRows]):
     """A file's steps; iterating them tells the post which instruction is being written."""
 
-    def __init__(self, steps: Sequence[PostStep], post: Post) -> None:
+    def __init__(self, steps: Sequence[PostStep | PostRows], post: Post) -> None:
         super().__init__(steps)
         self.post = post
 
-    def __iter__(self) -> Iterator[PostStep]:
+    def __iter__(self) -> Iterator[PostStep | PostRows]:
         for step in super().__iter__():
             self.post.current_step = step
             yield step
@@ -189,7 +191,9 @@ class _Renderer:
         ]
         allocation = self.view.allocate(names)
         if not split:
-            return self._files(self.manifest.files, self._unit(parts[0], allocation, 0, 0, entry))
+            out = self._files(self.manifest.files, self._unit(parts[0], allocation, 0, 0, entry))
+            progress.advance(len(parts[0]))
+            return out
         main = self._unit((), allocation, 0, len(parts), entry)
         main["parts"] = [
             {"name": n, "index": k + 1, "routine": r}
@@ -202,6 +206,7 @@ class _Renderer:
         for k, (steps, unit_name) in enumerate(zip(parts, unit_names, strict=True)):
             unit = self._unit(steps, allocation, k + 1, len(parts), routines[k], unit_name)
             files.update(self._files(self.manifest.files, unit, clash=files.keys() | main_files))
+            progress.advance(len(steps))
         return {**main_files, **files}
 
     def _unit(
@@ -230,7 +235,7 @@ class _Renderer:
                 "is_main": index == 0,
             },
             "parts": [],
-            "steps": TrackedSteps(view, self.post),
+            "steps": TrackedSteps(self.post.group(view), self.post),
             "tools": tools,
             "frames": frames,
             "vendor": self.post.context_values(view),

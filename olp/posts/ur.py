@@ -21,9 +21,20 @@ Conventions shared with frontends (rotation vectors, the flange, no configuratio
   base *is* the controller's Base, DH frame 0, see :mod:`olp.kinematics.ur`; the target equals
   forward kinematics of the planned joints, which resolve solved for it), and olp's user frames
   need no counterpart on the controller. ``v`` = ``Speed.linear`` (m/s), ``a`` = URScript's default
-  1.2 m/s² (the IR has no linear acceleration). ``mode=0``: orientation interpolated from the
-  start to the end pose, like KRL's default CIRC (URScript manual, ``movec``; medium
-  confidence).
+  1.2 m/s² (the IR has no linear acceleration). ``mode=0`` ("Unconstrained mode. Interpolate
+  orientation from current pose to target pose") for :attr:`~olp.ir.ArcOrientation.INTERPOLATE`
+  and ``mode=1`` ("Fixed mode. Keep orientation constant relative to the tangent of the circular
+  arc") for :attr:`~olp.ir.ArcOrientation.PATH_CONSTANT`; the via pose's rotation is not used
+  (URScript manual, ``movec``, SW 10.10; high confidence). Other rules and circular angles are
+  errors (:attr:`UrPost.ARC_ORIENTATIONS`).
+* Blends at arcs (:meth:`UrPost.check_program`, kind ``arc_blend``): a ``movec`` with ``r > 0``
+  followed by another ``movec`` is refused: an arc-to-arc blend is the case a ROS-Industrial
+  UR driver changed its blend radii for ("to avoid CIRC_ARC_BLENDING_RADIUS", a controller
+  message); which radii the controller accepts there is not documented in any source found, so
+  olp writes none (low confidence on the exact rule, high that the case is refused at least for
+  some radii). Also refused: a blend sphere at either end of an arc that holds the via point
+  (the blend would cut the arc before its defining point; olp's rule, like the overlapping
+  blends the controller skips).
 * ``r`` (m): the zone radius capped by :mod:`olp.transforms.blend` (neighbouring blends must not
   overlap, ``r = 0`` where the robot stops; project vendor notes).
 * ``set_tcp(p[...])``: the tool's TCP in the flange frame, before the first motion with it.
@@ -52,13 +63,16 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from olp.diagnostics import Diagnostic
+from olp.ir import ArcOrientation
 from olp.posts.base import Filter, Post
 from olp.posts.numbers import NumberFormat
+from olp.posts.sandbox import SafeText
 from olp.posts.text import NUMBER, ArgumentRule, CommentRule, NameRule
 from olp.vendors.ur import pose_to_ur
 
 if TYPE_CHECKING:
     from olp.compiled import CompiledProgram
+    from olp.posts.rows import PostRows
     from olp.posts.view import PostStep
 
 _KEYWORDS = """
@@ -148,10 +162,46 @@ def seconds(post: Post, value: float) -> str:
     return post.number("sleep", value)
 
 
+def ur_rows(post: Post, rows: PostRows) -> SafeText:
+    """The lines of a run of ``movel`` (:mod:`olp.posts.rows`), exactly as
+    ``program.script.j2`` writes each: ``set_tcp`` where the tool changes, then
+    ``movel(p[..], a=.., v=.., r=..)`` with the target in the robot's Base frame. Poses, speeds
+    and radii are formatted as columns; every piece is a checked number, so the lines are
+    :class:`~olp.posts.sandbox.SafeText`."""
+    steps = rows.steps
+    v = pose_to_ur(np.stack([s.base_pose for s in steps]))  # type: ignore[misc]
+    xyz = post.number_column("position", v[:, :3], steps)
+    rot = post.number_column("angle", v[:, 3:], steps)
+    speeds = post.number_column("speed", [s.speed.linear for s in steps], steps)
+    radii = post.number_column("radius", [s.zone.radius for s in steps], steps)
+    accelerations: dict[Any, str] = {}
+    lines: list[str] = []
+    for k, step in enumerate(steps):
+        post.current_step = step
+        if step.new_tool:
+            assert step.tool is not None
+            lines.append(f"  set_tcp({ur_pose(post, step.tool.pose)})")  # type: ignore[arg-type]
+        a = accelerations.get(step.speed)
+        if a is None:
+            a = accelerations[step.speed] = movel_acceleration(post, step.speed)
+        p = 3 * k
+        pose = f"p[{xyz[p]}, {xyz[p + 1]}, {xyz[p + 2]}, {rot[p]}, {rot[p + 1]}, {rot[p + 2]}]"
+        lines.append(f"  movel({pose}, a={a}, v={speeds[k]}, r={radii[k]})")
+    post.current_step = rows
+    return SafeText("\n".join(lines))
+
+
 def _via_filter(post: Post, step: PostStep) -> str:
     """Template filter: ``s | ur_via``, the ``p[...]`` of a circle's via point in the robot's
     Base frame (the post's ``frames_in: robot_base`` makes ``frame_pose`` relative to it)."""
     return ur_pose(post, np.asarray(step.frame_pose) @ np.asarray(step.via))
+
+
+def movec_mode(post: Post, step: PostStep) -> str:
+    """``mode`` of ``movec``: 0 interpolates start to end, 1 keeps the orientation constant
+    relative to the arc's tangent (URScript manual, ``movec``)."""
+    ins: Any = step.instruction
+    return "1" if ins.orientation is ArcOrientation.PATH_CONSTANT else "0"
 
 
 def _blends_filter(post: Post, steps: Any, station: Any) -> dict[int, float]:
@@ -177,6 +227,8 @@ FILTERS: Mapping[str, Filter] = {
     "ur_movel_a": movel_acceleration,
     "ur_radius": radius,
     "ur_seconds": seconds,
+    "ur_movec_mode": movec_mode,
+    "ur_rows": ur_rows,
 }
 
 
@@ -199,23 +251,74 @@ class UrPost(Post):
     LANGUAGE = "URScript"
     NAME_RULE = NAME_RULE
     COMMENTS = CommentRule(collapse=True)
+    ROWS = True
     IO_RANGE = (0, 9)
     CALL_ARGUMENTS = ArgumentRule(_LITERAL, 'numbers and "strings" without " or \\')
     NUMBERS: ClassVar[Mapping[str, NumberFormat]] = NUMBERS
     FILTERS: ClassVar[Mapping[str, Filter]] = FILTERS
     TRANSFORMS = (cap_blend_radii,)
+    ARC_ORIENTATIONS = frozenset({ArcOrientation.INTERPOLATE, ArcOrientation.PATH_CONSTANT})
 
     def check_program(self, compiled: CompiledProgram) -> list[Diagnostic]:
-        """``program_too_long`` (warning): more than :data:`MAX_MOTIONS` motions."""
+        """``program_too_long`` (warning): more than :data:`MAX_MOTIONS` motions;
+        ``arc_blend`` (error): blends at arcs the controller refuses (module docstring)."""
+        found = arc_blends(compiled)
         motions = sum(1 for s in compiled.steps if s.joints is not None)
         if motions <= MAX_MOTIONS:
-            return []
+            return found
         return [
+            *found,
             Diagnostic(
                 "warning",
                 "program_too_long",
                 f"{motions} motions in one script: UR controllers are reported to fail on "
                 f"scripts beyond about {MAX_MOTIONS} targets",
                 hint="split the program or stream it to the controller",
-            )
+            ),
         ]
+
+
+def arc_blends(compiled: CompiledProgram) -> list[Diagnostic]:
+    """Errors for ``movec`` blends the controller refuses (see the module docstring): an arc
+    blended into another arc, and a blend sphere around either end of an arc that holds its via
+    point (radii after :func:`cap_blend_radii`)."""
+    motions = [s for s in compiled.steps if s.joints is not None and not s.skipped]
+    out: list[Diagnostic] = []
+    for k, step in enumerate(motions):
+        ins: Any = step.instruction
+        if ins.kind != "circular":
+            continue
+        before = motions[k - 1].instruction if k > 0 else None
+        if before is not None and before.kind == "circular" and not before.zone.is_fine:
+            msg = (
+                "URScript cannot blend a movec into another movec (the controller refuses such "
+                "blends, CIRC_ARC_BLENDING_RADIUS): program a fine stop or a short linear move "
+                "between the arcs"
+            )
+            out.append(Diagnostic("error", "arc_blend", msg, ins.span, step.index))
+            continue
+        out += _via_in_blend(motions, k, compiled.station.robot)
+    return out
+
+
+def _via_in_blend(motions: list[Any], k: int, robot: Any) -> list[Diagnostic]:
+    """The error of a blend sphere at the start or end of arc ``k`` that holds its via point."""
+    step = motions[k]
+    ins: Any = step.instruction
+    if step.frame is None or step.frame.pose is None:
+        return []
+    via = (step.frame.pose @ ins.via.pose)[:3, 3]
+    ends = [(motions[k - 1], "start")] if k > 0 else []
+    ends.append((step, "end"))
+    for end_step, where in ends:
+        radius = end_step.instruction.zone.radius
+        if radius <= 0.0 or end_step.tool is None or end_step.tool.pose is None:
+            continue
+        tcp = (robot.flange_poses(end_step.joints) @ end_step.tool.pose)[:3, 3]
+        if np.linalg.norm(tcp - via) < radius:
+            msg = (
+                f"the blend radius of {radius * 1000:g} mm at the arc's {where} holds its via "
+                "point: the controller would cut the arc before the point that defines it"
+            )
+            return [Diagnostic("error", "arc_blend", msg, ins.span, step.index)]
+    return []

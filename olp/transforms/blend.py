@@ -133,10 +133,11 @@ def blend_radii(
     ``steps``: instructions in program order; a motion without joints (not emitted) is left
     out. ``start_joints``: (dof,) rad, where the program starts (for the first segment).
     """
+    steps = list(steps)  # a toolpath's rows are made into steps once
     motions = [s for s in steps if is_motion(s.instruction) and s.joints is not None]
     if not motions:
         return []
-    stops = _stop_flags(steps, {id(s) for s in motions})
+    stops = _stop_flags(steps, {s.index for s in motions})
     joints = np.stack([np.asarray(s.joints, dtype=np.float64) for s in motions])
     tools = np.stack([np.asarray(s.tool.pose, dtype=np.float64) for s in motions])
     tcp = robot.flange_poses(joints) @ tools
@@ -149,12 +150,12 @@ def blend_radii(
     ]
 
 
-def _stop_flags(steps: Sequence[StepLike], motion_ids: set[int]) -> NDArray[np.bool_]:
-    """Per emitted motion: is it the last one, or followed by a stop instruction before the
-    next emitted motion?"""
+def _stop_flags(steps: Sequence[StepLike], motions: set[int]) -> NDArray[np.bool_]:
+    """Per emitted motion (``motions``: their instruction indices): is it the last one, or
+    followed by a stop instruction before the next emitted motion?"""
     flags: list[bool] = []
     for step in steps:
-        if id(step) in motion_ids:
+        if step.index in motions:
             flags.append(False)
         elif flags and isinstance(step.instruction, STOP_TYPES):
             flags[-1] = True

@@ -234,14 +234,29 @@ def has_config(robot: Any) -> bool:
 def selecting_configs(robot: Any, joints: ArrayLike) -> list[str | None]:
     """Per planned joint vector (N, 6) rad: its CONFIG when that selects it alone among the IK
     solutions (with turn variants, within the limits) of its pose, else None (write the position
-    as joints). Vectorised: IK for all poses at once, :func:`satisfies` once per distinct
-    CONFIG."""
-    from olp.kinematics.base import turn_variants
-    from olp.kinematics.configuration import satisfies
+    as joints). Vectorised in batches of :data:`SELECT_ROWS`: IK for all poses of a batch at
+    once, :func:`satisfies` once per distinct CONFIG."""
 
     q = np.asarray(joints, dtype=np.float64).reshape(-1, 6)
     if q.shape[0] == 0 or not has_config(robot):
         return [None] * q.shape[0]
+    out: list[str | None] = []
+    for lo in range(0, q.shape[0], SELECT_ROWS):
+        out += _selecting_configs(robot, q[lo : lo + SELECT_ROWS])
+    return out
+
+
+SELECT_ROWS = 4096
+"""Joint vectors per batch of :func:`selecting_configs`: each row holds its IK solutions with
+their turn variants (8 branches x up to 18 turns x 6 joints) and the masks over them, about
+30 kB; batches keep a toolpath's memory bounded (a million rows at once took ~30 GB)."""
+
+
+def _selecting_configs(robot: Any, q: FloatArray) -> list[str | None]:
+    """:func:`selecting_configs` of one batch (n, 6) rad."""
+    from olp.kinematics.base import turn_variants
+    from olp.kinematics.configuration import satisfies
+
     flags = branch_flags(robot, q)
     turns = turn_number(q[:, list(TURN_AXES)]).tolist()
     configs = [

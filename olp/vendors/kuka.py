@@ -34,7 +34,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from olp.geometry import pose_from, rotation_from_zyx, roty, zyx_from_rotation
-from olp.ir import Configuration
+from olp.ir import ArcOrientation, Configuration
 from olp.kinematics.configuration import (
     SNAP,
     ArmModel,
@@ -166,3 +166,26 @@ def turn_ambiguous(joints: ArrayLike, lower: ArrayLike, upper: ArrayLike) -> NDA
         same_sign = (other < -ZERO) == (q < -ZERO)
         out |= np.any(same_sign & (other >= lo) & (other <= hi), axis=-1)
     return out
+
+
+ARC_ORIENTATIONS: dict[tuple[str, str], ArcOrientation] = {
+    ("VAR", "BASE"): ArcOrientation.INTERPOLATE,
+    ("CONSTANT", "BASE"): ArcOrientation.CONSTANT,
+    ("VAR", "PATH"): ArcOrientation.PATH,
+    ("CONSTANT", "PATH"): ArcOrientation.PATH_CONSTANT,
+    ("JOINT", "BASE"): ArcOrientation.WRIST,
+    ("JOINT", "PATH"): ArcOrientation.WRIST,
+}
+"""KUKA ``($ORI_TYPE, $CIRC_TYPE)`` -> olp's arc orientation rule. ``#VAR`` interpolates the
+orientation from the start to the end point, ``#CONSTANT`` keeps the start's, ``#JOINT``
+interpolates the wrist axes; ``#BASE`` refers the orientation to the base, ``#PATH`` to the
+path (it turns with the arc). Defaults ``#VAR`` and ``#BASE`` (the inline forms' LDAT default
+``ORI_TYP #VAR, CIRC_TYP #BASE``). Sources: KUKA knowledge-base articles on ``$ORI_TYPE`` and
+``$CIRC_TYPE`` and the KSS inline forms' LDAT (medium confidence); how olp models each rule:
+:mod:`olp.arcs`."""
+
+ARC_TYPES: dict[ArcOrientation, tuple[str, str]] = {
+    rule: types for types, rule in reversed(ARC_ORIENTATIONS.items())
+}
+"""olp's arc orientation rule -> the ``($ORI_TYPE, $CIRC_TYPE)`` the KRL post writes for it
+(``#VAR`` for the wrist rule's ``#JOINT`` pairs is never needed: the post refuses that rule)."""

@@ -357,3 +357,17 @@ def test_in_process_runs_stay_available_for_trusted_text(station: Station) -> No
         run_dsl(HOME + "raise KeyboardInterrupt\n", "prog.py", station)
     with pytest.raises(ParseError):
         run_dsl("x = 1\n", "prog.py", station)
+
+
+def test_a_circular_move_comes_back_from_the_child(tmp_path: Path, station: Station) -> None:
+    """A circular move holds an :class:`~olp.ir.ArcOrientation` (an enumeration): the result
+    reader took only olp's data classes, so every program with a MoveC failed to come back."""
+    text = (
+        "robot.setPoseFrame('table')\n"
+        "robot.MoveJ(Pose(0, 0, 100, 180, 0, 180))\n"
+        "robot.MoveC(Pose(50, 50, 100, 180, 0, 180), Pose(100, 0, 100, 180, 0, 180))\n"
+    )
+    result = load_dsl(program(tmp_path, text), station)
+    arc = result.program.instructions[-1]
+    assert isinstance(arc, ir.CircularMove) and isinstance(arc.orientation, ir.ArcOrientation)
+    assert arc == run_dsl(text, str(tmp_path / "prog.py"), station).program.instructions[-1]

@@ -1180,3 +1180,50 @@ def test_the_advancement_gives_up_instead_of_running_for_ever(
     with pytest.raises(Unresolved, match="below floating-point resolution") as caught:
         advance(_Constant(1.5e20, 0.0), None, run, lower, upper, cum)  # type: ignore[arg-type]
     assert caught.value.where.motion == 0 and 0.5 < caught.value.where.fraction < 1.0
+
+
+# --------------------------------------------------------------------------------------------
+# Dense toolpaths
+
+
+def _as_path(moves: list[ir.LinearMove]) -> ir.LinearPath:
+    """Consecutive linear moves (one tool, one frame) as one dense toolpath node."""
+    return ir.LinearPath(
+        poses=np.stack([m.target.pose for m in moves if isinstance(m.target, ir.CartesianTarget)]),
+        speeds=np.array([m.speed.linear for m in moves]),
+        zones=np.array([m.zone.radius for m in moves]),
+        lines=np.array([m.span.line for m in moves]),
+        tool=moves[0].tool,
+        source="t.src",
+    )
+
+
+@pytest.mark.parametrize(
+    "attachments",
+    [
+        (),  # the block joins its run whole
+        (Attachment("puck", grasp=1),),  # gripped at the block's first row: still whole
+        (Attachment("puck", grasp=1, release=3),),  # let go inside the block: row by row
+    ],
+)
+def test_a_dense_toolpath_is_checked_as_its_moves_are(
+    pick_cell: tuple[Station, np.ndarray], attachments: tuple[Attachment, ...]
+) -> None:
+    station, grip = pick_cell
+    at = station.robot.flange_poses(grip) @ ROD.pose
+    moves = [
+        _lin(transl(0, 0, 0.03) @ at, 3),  # lift 30 mm
+        _lin(transl(0, 0.2, 0.03) @ at, 4),  # across the wall
+        _lin(transl(0, 0.2, 0.06) @ at, 6),
+        _lin(transl(0, 0.2, -0.05) @ at, 7),  # down through where the puck was let go
+        _lin(transl(0, 0.0, -0.05) @ at, 8),  # back through the tray
+    ]
+    options = CollisionOptions(attachments=attachments, tool_touches_parts=False)
+    per_move = check_collisions(_compile(station, _ptp(grip, 1), *moves), options)
+    compiled = _compile(station, _ptp(grip, 1), _as_path(moves))
+    assert len(compiled.steps.blocks) == 2  # type: ignore[attr-defined]
+    dense = check_collisions(compiled, options)
+    assert per_move, "the program must collide somewhere for this test to mean anything"
+    assert [(d.kind, d.index, d.span, d.message) for d in dense] == [
+        (d.kind, d.index, d.span, d.message) for d in per_move
+    ]

@@ -76,6 +76,44 @@ def _after_ready(*instructions: ir.Instruction) -> Make:
     return lambda station, post: [_ready(station, post), *instructions]
 
 
+HALF_CIRCLES = [
+    (transl(0.01, 0.0, 0.01), transl(0.0, 0.0, 0.02)),
+    (transl(-0.01, 0.0, 0.01), transl(0.0, 0.0, 0.0)),
+]
+"""Half circles of radius 10 mm about the point 10 mm along the flange's z at READY, in its x-z
+plane: via 10 mm along x and z, end 20 mm along z (the linear row's "away" point); then back
+by the mirrored half circle."""
+ARC_30 = [
+    (
+        transl(0.01 * np.sin(np.pi / 12), 0.0, 0.01 * (1 - np.cos(np.pi / 12))),
+        transl(0.01 * np.sin(np.pi / 6), 0.0, 0.01 * (1 - np.cos(np.pi / 6))),
+    )
+]
+"""The first 30° of the first half circle, its via point at 15° (the tool turns 30° with it)."""
+
+
+def _arcs(
+    *arcs: dict[str, object], points: list[tuple[np.ndarray, np.ndarray]] = HALF_CIRCLES
+) -> Make:
+    """From READY, one circular move per ``arcs`` (its extra fields) through ``points``."""
+
+    def make(station: Station, post: str) -> list[ir.Instruction]:
+        flange = station.robot.flange_poses(np.radians(READY[post]))
+        out: list[ir.Instruction] = [_ready(station, post)]
+        for (via, end), fields in zip(points, arcs, strict=False):
+            out.append(
+                ir.CircularMove(
+                    target=ir.CartesianTarget(pose=flange @ end),
+                    via=ir.CartesianTarget(pose=flange @ via),
+                    speed=ir.Speed(linear=0.1),
+                    **fields,  # type: ignore[arg-type]
+                )
+            )
+        return out
+
+    return make
+
+
 ROWS: dict[str, Row] = {
     "joint move to axis values": Row(
         lambda station, post: [_ready(station, post)],
@@ -212,6 +250,79 @@ ROWS: dict[str, Row] = {
     "comment with a control character": Row(
         _after_ready(ir.Comment(text="bell\x07")),
         {post: Error("comment") for post in POSTS},
+    ),
+    "circular move through three points": Row(
+        _arcs({}),
+        {
+            "kuka": [
+                "$ORI_TYPE = #VAR",
+                "$CIRC_TYPE = #BASE",
+                "CIRC {X 515.711,Y -400.000,Z 833.431,A 0.0000,B 45.0000,C 0.0000}, "
+                "{X 515.711,Y -400.000,Z 847.574,A 0.0000,B 45.0000,C 0.0000,S 2,T 2}",
+            ],
+            "abb": ["MoveC p2_via, p2, v100, fine, tool0\\WObj:=world;"],
+            "ur": [
+                "movec(p[-0.491900, -0.123300, 0.477900, 2.221441, 2.221441, 0.000000], "
+                "p[-0.491900, -0.133300, 0.467900, 2.221441, 2.221441, 0.000000], "
+                "a=1.20000, v=0.10000, r=0.000000, mode=0)"
+            ],
+            "fanuc": ["C P[2]", ":  P[3] 100mm/sec FINE    ;"],
+        },
+    ),
+    "circular move with a circular angle": Row(
+        _arcs({"angle": np.radians(90.0)}),
+        {
+            "kuka": [
+                "CIRC {X 515.711,Y -400.000,Z 833.431,A 0.0000,B 45.0000,C 0.0000}, "
+                "{X 515.711,Y -400.000,Z 847.574,A 0.0000,B 45.0000,C 0.0000,S 2,T 2}, CA 90.0000"
+            ],
+            "abb": Error("arc_angle"),
+            "ur": Error("arc_angle"),
+            "fanuc": Error("arc_angle"),
+        },
+    ),
+    "circular move turning the tool with the path": Row(
+        _arcs({"orientation": ir.ArcOrientation.PATH_CONSTANT}, points=ARC_30),
+        {
+            "kuka": [
+                "$ORI_TYPE = #CONSTANT",
+                "$CIRC_TYPE = #PATH",
+                "CIRC {X 503.640,Y -400.000,Z 831.842,A 0.0000,B 45.0000,C 0.0000}, "
+                "{X 506.051,Y -400.000,Z 830.843,A 0.0000,B 45.0000,C 0.0000,S 2,T 2}",
+            ],
+            "abb": Error("arc_orientation"),
+            "ur": [
+                "movec(p[-0.491900, -0.130712, 0.487559, 2.221441, 2.221441, 0.000000], "
+                "p[-0.491900, -0.128300, 0.486560, 2.221441, 2.221441, 0.000000], "
+                "a=1.20000, v=0.10000, r=0.000000, mode=1)"
+            ],
+            "fanuc": Error("arc_orientation"),
+        },
+    ),
+    "circular move blended into a circular move": Row(
+        _arcs({"zone": ir.Zone(0.003)}, {}),
+        {
+            "kuka": [
+                "$APO.CDIS = 3.000",
+                "$ORI_TYPE = #VAR",
+                "$CIRC_TYPE = #BASE",
+                "CIRC {X 515.711,Y -400.000,Z 833.431,A 0.0000,B 45.0000,C 0.0000}, "
+                "{X 515.711,Y -400.000,Z 847.574,A 0.0000,B 45.0000,C 0.0000,S 2,T 2} C_DIS",
+                "CIRC {X 501.569,Y -400.000,Z 847.574,A 0.0000,B 45.0000,C 0.0000}, "
+                "{X 501.569,Y -400.000,Z 833.431,A 0.0000,B 45.0000,C 0.0000,S 2,T 2}",
+            ],
+            "abb": [
+                "MoveC p2_via, p2, v100, z3, tool0\\WObj:=world;",
+                "MoveC p3_via, p3, v100, fine, tool0\\WObj:=world;",
+            ],
+            "ur": Error("arc_blend"),
+            "fanuc": [
+                "C P[2]",
+                ":  P[3] 100mm/sec CNT3    ;",
+                "C P[4]",
+                ":  P[5] 100mm/sec FINE    ;",
+            ],
+        },
     ),
     "dwell too long to write": Row(
         _after_ready(ir.Wait(seconds=1e300)),

@@ -58,6 +58,8 @@ USERS_JOBS: dict[str, tuple[str, str, dict[str, Any]]] = {
     "job6_feasibility_grid": (KUKA_CELL, "examples/feasibility_grid.py", {}),
 }
 
+ENDINGS = {"kuka": "\r\n", "abb": "\r\n", "ur": "\n", "fanuc": "\r\n"}
+
 CASES: dict[tuple[str, str], tuple[str, str, dict[str, Any]]] = {
     **{("kuka", job): case for job, case in USERS_JOBS.items()},
     **{("abb", job): case for job, case in USERS_JOBS.items()},
@@ -66,11 +68,10 @@ CASES: dict[tuple[str, str], tuple[str, str, dict[str, Any]]] = {
     ("ur", "transpile"): (UR_CELL, TRANSPILE, {}),
     ("fanuc", "job5_milling"): USERS_JOBS["job5_milling"],
     ("fanuc", "transpile"): (FANUC_CELL, TRANSPILE, {}),
+    **{(post, "weld_rounded"): (KUKA_CELL, "examples/weld_rounded.src", {}) for post in ENDINGS},
 }
 SPLIT = [("kuka", "job5_milling_split"), ("abb", "job5_milling_split")]
 """Job 5 through a copy of the post that allows 3 motions per file."""
-
-ENDINGS = {"kuka": "\r\n", "abb": "\r\n", "ur": "\n", "fanuc": "\r\n"}
 
 
 def _post(post: str, job: str, tmp_path: Path) -> str:

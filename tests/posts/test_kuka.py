@@ -291,7 +291,9 @@ def test_circular_moves(station: Station) -> None:
     compiled = _circular_program(station)
     via = "X 138.113,Y 50.000,Z 6.350,A 180.0000,B 0.0000,C 180.0000"
     inline = _body(render(compiled, _post())["Row.src"])
-    _match(inline[-2:], ["$APO.CDIS = 2.000", f"CIRC {{{via}}}, {{{SIDE},{ST}}} C_DIS"])
+    # the first arc states its orientation rule: the controller's state is not olp's to assume
+    arc = f"CIRC {{{via}}}, {{{SIDE},{ST}}} C_DIS"
+    _match(inline[-4:], ["$APO.CDIS = 2.000", "$ORI_TYPE = #VAR", "$CIRC_TYPE = #BASE", arc])
     named = render(compiled, _post(points="dat"))
     assert _body(named["Row.src"])[-1] == "CIRC XA3, XP3 C_DIS"
     assert f"DECL E6POS XA3={{{via}}}" in named["Row.dat"].split("\r\n")

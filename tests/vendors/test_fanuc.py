@@ -287,3 +287,21 @@ def test_ls_numbers_have_no_negative_zero() -> None:
         "-90.000",
         "0.000",
     ]
+
+
+def test_config_selection_in_batches_is_the_selection_at_once(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    from pathlib import Path
+
+    from olp.station.loader import load_station
+
+    cell = Path(__file__).resolve().parents[2] / "stations" / "fanuc_m20ia_weld_cell.yaml"
+    robot = load_station(cell).robot
+    rng = np.random.default_rng(7)
+    q = rng.uniform(robot.limits.lower, robot.limits.upper, size=(40, 6))
+    q[::5, 4] = 0.0  # wrist singular: several solutions share a CONFIG, written as joints
+    whole = fanuc.selecting_configs(robot, q)
+    assert any(c is None for c in whole) and any(c is not None for c in whole)
+    monkeypatch.setattr(fanuc, "SELECT_ROWS", 3)
+    assert fanuc.selecting_configs(robot, q) == whole

@@ -159,7 +159,7 @@ class InlineForms(Core):
                 f"WITH {self.sources.snippet(assign.span)!r}: olp does not know {value.name}(...)",
                 assign.span,
                 hint="olp reads the spline inline forms' SVEL_JOINT, SVEL_CP, SACC_JOINT, STOOL2, "
-                "SBASE, SIPO_MODE, SAPO and SAPO_PTP",
+                "SBASE, SIPO_MODE, SAPO, SAPO_PTP, SORI_TYP and SCIRC_TYP",
             )
 
     def _with_functions(self) -> dict[tuple[str, str], Callable[[FuncCall, Assign], None]]:
@@ -188,7 +188,21 @@ class InlineForms(Core):
             ("$APO", "SAPO_PTP"): lambda f, a: self._cdis(
                 self._record_number(f, "APO_DIST"), a.span, "APO_DIST (mm)"
             ),
+            ("$ORI_TYPE", "SORI_TYP"): lambda f, a: self._record_type(f, "ORI_TYP", "$ORI_TYPE"),
+            ("$CIRC_TYPE", "SCIRC_TYP"): lambda f, a: self._record_type(
+                f, "CIRC_TYP", "$CIRC_TYPE"
+            ),
         }
+
+    def _record_type(self, call: FuncCall, member: str, name: str) -> None:
+        """``$ORI_TYPE = SORI_TYP(LCPDAT1)``: the LDAT's ``ORI_TYP`` (``CIRC_TYP``); an LDAT
+        without the member leaves the type as it was."""
+        last = call.args[-1] if call.args else None
+        if last is None:
+            raise self._error(f"{call.name}(...) needs a data set as its last argument", call.span)
+        found = self._aggregate(last, f"{call.name} reads").member(member)
+        if found is not None:
+            self._orientation_type(name, self._value(found.value), found.value.span)
 
     def _arg(self, call: FuncCall, index: int) -> Expr:
         arg = call.args[index] if index < len(call.args) else None

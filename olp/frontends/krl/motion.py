@@ -74,6 +74,7 @@ class Motions(InlineForms):
         state, track = self.state, self.track
         if (
             self._after_with is not None
+            or (base == "LIN" and state.ori_type != "VAR")
             or stmt.type_name is not None
             or not all(map(math.isfinite, stmt.values))
         ):
@@ -135,8 +136,8 @@ class Motions(InlineForms):
         if len(stmt.targets) != expected:
             message = f"{stmt.keyword} takes {expected} target{'s' if expected > 1 else ''}"
             raise self._error(f"{message}, found {len(stmt.targets)}", stmt.span)
-        if stmt.angle is not None:
-            raise self._error("CIRC with CA (circular angle) is not supported yet", stmt.angle.span)
+        if stmt.angle is not None and base != "CIRC":
+            raise self._error(f"{stmt.keyword} takes no CA (only CIRC does)", stmt.angle.span)
         relative = stmt.keyword.endswith("_REL")
         if stmt.frame_option is not None and not relative:
             raise self._error(
@@ -163,8 +164,42 @@ class Motions(InlineForms):
             self.track.cartesian, self.track.no_cartesian = start
         target = self._point(stmt, stmt.targets[-1], relative)
         self._note_default_speed(stmt)
+        fields = self._fields(stmt, zone)
+        if base == "CIRC":
+            fields.update(self._arc_fields(stmt))
+        else:
+            self._note_line_orientation(stmt)
         make = ir.CircularMove if base == "CIRC" else ir.LinearMove
-        self._emit(make, target, via, self._fields(stmt, zone))
+        self._emit(make, target, via, fields)
+        if stmt.angle is not None:
+            line = stmt.span.line
+            self.track.lose_cartesian(f"the CIRC with CA at line {line} ends off its end point")
+
+    def _arc_fields(self, stmt: MotionStmt) -> dict[str, Any]:
+        """A CIRC's circular angle (``CA``, degrees, signed, not 0) and orientation rule (the
+        state's ``$ORI_TYPE`` and ``$CIRC_TYPE``, :data:`olp.vendors.kuka.ARC_ORIENTATIONS`).
+        SCIRC follows the same rules in olp (its ``$CIRC_MODE`` is not modelled: noted)."""
+        fields: dict[str, Any] = {"orientation": self.state.arc_orientation}
+        if stmt.keyword == "SCIRC":
+            message = (
+                "SCIRC is planned like CIRC: orientation by $ORI_TYPE/$CIRC_TYPE, the auxiliary "
+                "point's orientation not reached ($CIRC_MODE is not modelled; unverified default)"
+            )
+            self._note(stmt.span, message, once="scirc-mode")
+        if stmt.angle is not None:
+            degrees = self._number(stmt.angle, "CA (circular angle, deg)")
+            if degrees == 0:
+                raise self._error("CA (circular angle) must not be 0", stmt.angle.span)
+            fields["angle"] = math.radians(degrees)
+        return fields
+
+    def _note_line_orientation(self, stmt: MotionStmt) -> None:
+        if self.state.ori_type != "VAR":
+            message = (
+                f"$ORI_TYPE #{self.state.ori_type} is not modelled for {stmt.keyword}: olp "
+                "interpolates the orientation from the start to the target"
+            )
+            self._note(stmt.span, message)
 
     def _point(self, stmt: MotionStmt, expr: Expr, relative: bool) -> Cartesian:
         target = self._relative(stmt, expr) if relative else self._cartesian(expr, stmt)

@@ -58,7 +58,7 @@ from olp.frontends.krl.values import (
     as_number,
     frame_values,
 )
-from olp.vendors.kuka import frame_to_pose
+from olp.vendors.kuka import ARC_ORIENTATIONS, frame_to_pose
 
 DEFAULT_VEL_CP = 2.0
 """m/s: ``$VEL.CP`` assumed before the program sets it (what ``BAS(#INITMOV, 0)`` is reported to
@@ -94,6 +94,17 @@ class State:
     cdis_mm: float | None = None
     tool: ir.Tool = field(default_factory=lambda: ir.FLANGE)
     frame: ir.Frame = field(default_factory=lambda: ir.WORLD)
+    ori_type: str = "VAR"  # $ORI_TYPE: VAR, CONSTANT or JOINT
+    circ_type: str = "BASE"  # $CIRC_TYPE: BASE or PATH
+
+    @property
+    def arc_orientation(self) -> ir.ArcOrientation:
+        """The rule of a CIRC under this state (:data:`olp.vendors.kuka.ARC_ORIENTATIONS`)."""
+        return ARC_ORIENTATIONS[(self.ori_type, self.circ_type)]
+
+
+ORI_TYPES = frozenset({"VAR", "CONSTANT", "JOINT"})
+CIRC_TYPES = frozenset({"BASE", "PATH"})
 
 
 @dataclass(slots=True)
@@ -153,8 +164,7 @@ SYSTEM_REASONS = {
     "$ACC.CP": "path acceleration ($ACC.CP) is not part of olp's IR",
     "$ACC": "path acceleration ($ACC) is not part of olp's IR",
     "$ADVANCE": "the advance run does not change the path",
-    "$ORI_TYPE": "the orientation control type is not lowered (olp interpolates orientation)",
-    "$CIRC_TYPE": "the orientation control type of CIRC is not lowered",
+    "$CIRC_MODE": "$CIRC_MODE is not lowered: olp ignores the auxiliary point's orientation",
     "$LOAD": "payload data are not part of olp's IR",
     "$GEAR_JERK[]": "gear jerk limits are not part of olp's IR",
     "$JERK": "jerk limits are not part of olp's IR",
@@ -315,6 +325,8 @@ class Core:
             "$OUT[]": self._set_output,
             "$H_POS": self._set_home,
             "$IPO_MODE": self._set_ipo_mode,
+            "$ORI_TYPE": self._set_ori_type,
+            "$CIRC_TYPE": self._set_circ_type,
         }
 
     # ---- reporting
@@ -497,6 +509,26 @@ class Core:
 
     def _set_ipo_mode(self, name: str, value: Expr, stmt: Stmt) -> None:
         self._ipo_mode(self._value(value), value.span)
+
+    def _set_ori_type(self, name: str, value: Expr, stmt: Stmt) -> None:
+        self._orientation_type("$ORI_TYPE", self._value(value), value.span)
+
+    def _set_circ_type(self, name: str, value: Expr, stmt: Stmt) -> None:
+        self._orientation_type("$CIRC_TYPE", self._value(value), value.span)
+
+    def _orientation_type(self, name: str, value: Value, span: ir.SourceSpan) -> None:
+        """``$ORI_TYPE`` (#VAR, #CONSTANT, #JOINT) or ``$CIRC_TYPE`` (#BASE, #PATH)."""
+        allowed = ORI_TYPES if name == "$ORI_TYPE" else CIRC_TYPES
+        found = value.name.upper() if isinstance(value, EnumValue) else None
+        if found not in allowed:
+            names = ", ".join(f"#{a}" for a in sorted(allowed))
+            raise self._error(
+                f"{name} must be one of {names}, found {self.sources.snippet(span)!r}", span
+            )
+        if name == "$ORI_TYPE":
+            self.state = dataclasses.replace(self.state, ori_type=found)
+        else:
+            self.state = dataclasses.replace(self.state, circ_type=found)
 
     def _ipo_mode(self, mode: Value, span: ir.SourceSpan) -> None:
         if isinstance(mode, EnumValue) and mode.name.upper() == "BASE":

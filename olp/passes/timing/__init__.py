@@ -74,8 +74,9 @@ The model, point by point (each choice is what the estimate can be explained by)
 * **Other instructions** take :data:`DEFAULT_TIMES` seconds (a ``Wait`` its own time); override
   any kind, or a named call as ``"call:NAME"``, through ``other_times``.
 
-The package, along those seams: :mod:`~olp.passes.timing.plan` (options, fixed times, the
-program's units and TCP travel), :mod:`~olp.passes.timing.ptp` (Ruckig),
+The package, along those seams: :mod:`~olp.passes.timing.plan` (options, fixed times),
+:mod:`~olp.passes.timing.table` (the program as rows of arrays, its TCP travel and which moves
+blend), :mod:`~olp.passes.timing.ptp` (Ruckig),
 :mod:`~olp.passes.timing.lines` (closed-form straight lines), :mod:`~olp.passes.timing.geometry`
 (a chain's joint path and blends), :mod:`~olp.passes.timing.problem` and
 :mod:`~olp.passes.timing.chains` (path problems and their time laws),
@@ -98,10 +99,7 @@ from olp.passes.timing.plan import (
     MIN_PATH_SPEED,
     TimingError,
     TimingOptions,
-    Unit,
     fixed_time,
-    plan_units,
-    tcp_lengths,
 )
 from olp.passes.timing.problem import PathProblem, speed_bounds
 from olp.passes.timing.program import time_program, timing_pass
@@ -125,7 +123,6 @@ __all__ = [
     "TcpLinearSpeedConstraint",
     "TimingError",
     "TimingOptions",
-    "Unit",
     "chain_geometry",
     "fixed_time",
     "gridpoints",
@@ -133,14 +130,12 @@ __all__ = [
     "line_profiles",
     "override_speeds",
     "path_problem",
-    "plan_units",
     "ptp_duration",
     "ptp_profile",
     "reachability_speeds",
     "speed_bounds",
     "speed_sweep",
     "straight_paths",
-    "tcp_lengths",
     "tcp_rates",
     "time_path",
     "time_program",

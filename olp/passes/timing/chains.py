@@ -1,91 +1,23 @@
-"""Path moves and blended chains: a time-optimal time law along each chain under the joint
-limits and the TCP speed, on a refined grid, solved by a path solver (:data:`PATH_SOLVERS`)."""
+"""Path moves and blended chains: the problem of timing a chain (its grid and TCP limits) and
+the time-optimal time law along it under the joint limits and the TCP speed, solved by a path
+solver (:data:`PATH_SOLVERS`). The pass times all chains of a program at once
+(:func:`olp.passes.timing.program.time_chains`)."""
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Callable, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
 
-from olp.compiled import Step
-from olp.diagnostics import Diagnostic
-from olp.ir import is_motion
-from olp.passes.timing.geometry import ChainGeometry, chain_geometry, joint_path
-from olp.passes.timing.plan import MIN_PATH_SPEED, Context, TimingError, TimingOptions, Unit
+from olp.passes.timing.geometry import ChainGeometry, joint_path
+from olp.passes.timing.plan import TimingError, TimingOptions
 from olp.passes.timing.problem import PathProblem
 from olp.passes.timing.reachability import PathSolver, reachability_solver
 from olp.station.model import Robot
-from olp.trajectory import PathTimeLaw, Segment
+from olp.trajectory import PathTimeLaw
 
 FloatArray = NDArray[np.float64]
-
-
-def time_chains(context: Context, units: Sequence[Unit]) -> tuple[list[Step], list[Diagnostic]]:
-    """Time chains of path moves: their geometry one by one, their time laws by
-    ``options.solver`` all at once."""
-    robot, opts = context.compiled.station.robot, context.options
-    done: list[Step] = []
-    found: list[Diagnostic] = []
-    posed: list[tuple[list[Step], ChainGeometry, PathProblem]] = []
-    for unit in units:
-        steps = [context.compiled.steps[i] for i in unit.indices]
-        tool = steps[0].tool.pose if steps[0].tool is not None else None
-        assert tool is not None
-        given = [s.instruction.speed for s in steps if is_motion(s.instruction)]
-        linear = np.array([sp.linear for sp in given], dtype=np.float64)
-        angular = np.array([np.inf if sp.angular is None else sp.angular for sp in given])
-        slow = _too_slow(steps, linear, angular)
-        if slow is not None:
-            found.append(slow)
-            continue
-        paths = [s.path for s in steps if s.path is not None]
-        geometry = chain_geometry(paths, robot, tool, unit.blends, opts.blend_samples)
-        if geometry.s[-1] <= 0.0:  # no joint moves: the TCP stays put
-            done += [dataclasses.replace(s, duration=0.0, path_length=0.0) for s in steps]
-            continue
-        posed.append((steps, geometry, path_problem(geometry, tool, linear, angular, opts)))
-    speeds = PATH_SOLVERS[opts.solver]([problem for _, _, problem in posed], robot)
-    for (steps, geometry, problem), sd in zip(posed, speeds, strict=True):
-        try:
-            done += _timed_chain(steps, geometry, _time_law(problem, sd))
-        except TimingError as exc:
-            span = steps[0].instruction.span
-            found.append(Diagnostic("error", "timing", str(exc), span, steps[0].index))
-    return done, found
-
-
-def _too_slow(steps: Sequence[Step], linear: FloatArray, angular: FloatArray) -> Diagnostic | None:
-    """The error for a chain with a programmed speed below :data:`MIN_PATH_SPEED`."""
-    slow = np.flatnonzero((linear < MIN_PATH_SPEED) | (angular < MIN_PATH_SPEED))
-    if slow.size == 0:
-        return None
-    k = int(slow[0])
-    which, value, unit = (
-        ("TCP speed", linear[k] * 1000, "mm/s")
-        if linear[k] < MIN_PATH_SPEED
-        else ("orientation speed", np.degrees(angular[k]), "°/s")
-    )
-    msg = (
-        f"the programmed {which} of {value:.3g} {unit} is too low to time (the slowest olp "
-        f"times is {MIN_PATH_SPEED:g} m/s or rad/s)"
-    )
-    return Diagnostic("error", "timing", msg, steps[k].instruction.span, steps[k].index)
-
-
-def _timed_chain(steps: Sequence[Step], geometry: ChainGeometry, law: PathTimeLaw) -> list[Step]:
-    """The chain's steps with their share of ``law``: durations between the boundaries."""
-    edges = law.time_at(geometry.boundaries)
-    return [
-        dataclasses.replace(
-            step,
-            duration=float(edges[k + 1] - edges[k]),
-            path_length=float(geometry.lengths[k]),
-            trajectory=Segment(law, float(edges[k]), float(edges[k + 1])),
-        )
-        for k, step in enumerate(steps)
-    ]
 
 
 def path_problem(
@@ -121,10 +53,10 @@ def time_path(
     """
     opts = options or TimingOptions()
     problem = path_problem(geometry, tool, linear_speed, angular_speed, opts)
-    return _time_law(problem, PATH_SOLVERS[opts.solver]([problem], robot)[0])
+    return time_law(problem, PATH_SOLVERS[opts.solver]([problem], robot)[0])
 
 
-def _time_law(problem: PathProblem, sd: FloatArray) -> PathTimeLaw:
+def time_law(problem: PathProblem, sd: FloatArray) -> PathTimeLaw:
     """The law of path speeds ``sd`` (K,) found for ``problem``, if it is one."""
     if not np.all(np.isfinite(sd)):
         raise TimingError("TOPPRA found no time law along this path (badly conditioned path)")

@@ -51,9 +51,9 @@ class _Samples:
     move: NDArray[np.int64]
 
     @classmethod
-    def of(cls, paths: Sequence[FloatArray], robot: Robot, tool: FloatArray) -> _Samples:
-        sizes = np.array([len(path) for path in paths], dtype=np.int64)
-        q = np.concatenate(paths)
+    def of(
+        cls, q: FloatArray, sizes: NDArray[np.int64], robot: Robot, tool: FloatArray
+    ) -> _Samples:
         first = np.cumsum(sizes) - sizes
         move = np.repeat(np.arange(sizes.size), sizes)
         steps = np.linalg.norm(np.diff(tcp_positions(robot, q, tool), axis=0), axis=-1)
@@ -119,8 +119,22 @@ def chain_geometry(
     """Join the sampled joint paths (S_k, dof) of M moves, cutting each inner corner at
     ``blends[k]`` m of TCP travel on both sides and joining the cuts by a blend curve.
     Vectorised over the moves (two forward kinematics calls for the whole chain)."""
-    samples = _Samples.of(paths, robot, tool)
-    moves = np.arange(len(paths))
+    sizes = np.array([len(path) for path in paths], dtype=np.int64)
+    return joined_geometry(np.concatenate(paths), sizes, robot, tool, blends, blend_samples)
+
+
+def joined_geometry(
+    q: FloatArray,
+    sizes: NDArray[np.int64],
+    robot: Robot,
+    tool: FloatArray,
+    blends: Sequence[float] | FloatArray,
+    blend_samples: int = 5,
+) -> ChainGeometry:
+    """:func:`chain_geometry` of M moves given end to end: joints ``q`` (S, dof) rad, each
+    move's samples (its start included) in turn, ``sizes`` (M,) samples per move."""
+    samples = _Samples.of(q, sizes, robot, tool)
+    moves = np.arange(sizes.size)
     d = np.asarray(blends, dtype=np.float64)
     enter = np.concatenate([[0.0], d])
     leave = samples.lengths - np.concatenate([d, [0.0]])

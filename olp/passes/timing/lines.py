@@ -3,20 +3,15 @@ moves of a program at once (see the package docstring)."""
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
-from olp.compiled import Step
 from olp.geometry import rotation_log
-from olp.ir import is_motion
-from olp.passes.timing.plan import Context, Unit, below_floor
 from olp.passes.timing.tcp import tcp_poses
 from olp.station.model import Robot
-from olp.trajectory import LineTimeLaw, Segment
 
 FloatArray = NDArray[np.float64]
 
@@ -164,7 +159,16 @@ def straight_paths(paths: Sequence[FloatArray], deviation: float) -> NDArray[np.
     sizes = np.array([len(path) for path in paths], dtype=np.int64)
     if sizes.size == 0:
         return np.zeros(0, dtype=bool)
-    q = np.concatenate(paths)
+    return straight_samples(np.concatenate(paths), sizes, deviation)
+
+
+def straight_samples(
+    q: FloatArray, sizes: NDArray[np.int64], deviation: float
+) -> NDArray[np.bool_]:
+    """:func:`straight_paths` of paths given end to end: joints ``q`` (S, dof) rad and the
+    sample count (M,) of each path."""
+    if sizes.size == 0:
+        return np.zeros(0, dtype=bool)
     first = np.cumsum(sizes) - sizes
     chord = q[first + sizes - 1] - q[first]
     length = np.linalg.norm(chord, axis=-1)
@@ -181,63 +185,3 @@ def straight_paths(paths: Sequence[FloatArray], deviation: float) -> NDArray[np.
 
 _MIN_LINE_RAD = 1e-9
 """Shorter joint paths are left to the chain timer (which times a move without motion as 0)."""
-
-
-def time_lines(context: Context, units: Sequence[Unit]) -> tuple[list[Step], list[Unit]]:
-    """Time every stop-to-stop path move along a straight joint line in closed form, all at
-    once; returns the timed steps and the units left for the other timers (the rest, and the
-    lines whose error bound exceeds ``line_tolerance``)."""
-    opts, all_steps = context.options, context.compiled.steps
-    # A move below MIN_PATH_SPEED goes to the chain timer, which reports it.
-    singles = [
-        u
-        for u in units
-        if u.kind == "path" and len(u.indices) == 1 and not below_floor(all_steps[u.indices[0]])
-    ]
-    if not opts.straight_lines or not singles:
-        return [], list(units)
-    paths = [all_steps[u.indices[0]].path for u in singles]
-    straight = straight_paths(paths, opts.line_deviation_rad)  # type: ignore[arg-type]
-    candidates = [u for u, ok in zip(singles, straight, strict=True) if ok]
-    if not candidates:
-        return [], list(units)
-    steps = [all_steps[u.indices[0]] for u in candidates]
-    profiles = _step_profiles(steps, context.compiled.station.robot)
-    accepted = profiles.excess <= opts.line_tolerance
-    timed = [
-        _line_step(step, profiles, k, context.lengths[step.index])
-        for k, step in enumerate(steps)
-        if accepted[k]
-    ]
-    done = {step.index for step, ok in zip(steps, accepted, strict=True) if ok}
-    return timed, [u for u in units if u.indices[0] not in done]
-
-
-def _step_profiles(steps: Sequence[Step], robot: Robot) -> LineProfiles:
-    """:func:`line_profiles` of resolved path moves along straight joint lines."""
-    paths = [s.path for s in steps if s.path is not None]
-    tools = [s.tool.pose for s in steps if s.tool is not None and s.tool.pose is not None]
-    speeds = [s.instruction.speed for s in steps if is_motion(s.instruction)]
-    return line_profiles(
-        np.stack([path[0] for path in paths]),
-        np.stack([path[-1] for path in paths]),
-        robot,
-        np.stack(tools),
-        np.array([sp.linear for sp in speeds], dtype=np.float64),
-        np.array([np.inf if sp.angular is None else sp.angular for sp in speeds]),
-    )
-
-
-def _line_step(step: Step, profiles: LineProfiles, k: int, length: float) -> Step:
-    """``step`` timed by the k-th of ``profiles``."""
-    assert step.path is not None
-    law = LineTimeLaw(
-        q0=step.path[0],
-        q1=step.path[-1],
-        accel=float(profiles.accel[k]),
-        ramp=float(profiles.ramp[k]),
-        total=float(profiles.duration[k]),
-    )
-    return dataclasses.replace(
-        step, duration=law.total, path_length=length, trajectory=Segment(law, 0.0, law.total)
-    )

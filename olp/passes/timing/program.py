@@ -1,37 +1,112 @@
-"""The timing pass itself: every unit of a program timed by its timer, the steps filled with
-durations, path lengths and trajectories, and what could not be timed as diagnostics."""
+"""The timing pass itself: every row of a program timed by its timer on the program's
+:class:`~olp.passes.timing.table.MotionTable`, the results written back to the steps (and to a
+toolpath's :class:`~olp.compiled.PathBlock` as arrays), and what could not be timed as
+diagnostics.
+
+The timers fill one :class:`Times` of flat arrays, one row per instruction: fixed-time rows from
+the time table, joint moves with Ruckig (:mod:`~olp.passes.timing.ptp`), stop-to-stop path moves
+along a straight joint line in closed form, all at once (:mod:`~olp.passes.timing.lines`), and
+the other chains of path moves with the path solver (:mod:`~olp.passes.timing.chains`). No
+object is made per toolpath row.
+"""
 
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable, Mapping, Sequence
-from typing import TYPE_CHECKING
+from collections.abc import Iterator, Mapping, Sequence
+from typing import TYPE_CHECKING, overload
 
 import numpy as np
 from numpy.typing import NDArray
 
-from olp.compiled import CompiledProgram, Step
+from olp.compiled import CompiledProgram, PathBlock, RowTrajectories, Step, items_of, make_steps
+from olp.compiled import span_of as _span
 from olp.diagnostics import Diagnostic
-from olp.passes.timing.chains import time_chains
-from olp.passes.timing.lines import time_lines
+from olp.ir import is_motion
+from olp.passes.timing import ptp
+from olp.passes.timing.chains import PATH_SOLVERS, path_problem, time_law
+from olp.passes.timing.geometry import joined_geometry
+from olp.passes.timing.lines import line_profiles, straight_samples
 from olp.passes.timing.plan import (
-    Context,
+    MIN_PATH_SPEED,
     TimingError,
     TimingOptions,
-    Unit,
-    plan_units,
-    tcp_lengths,
-    time_fixed,
+    fixed_time,
     time_table,
-    zone_stops,
 )
-from olp.passes.timing.ptp import time_joint
+from olp.passes.timing.table import (
+    COMMENT,
+    FIXED,
+    JOINT,
+    KIND_NAMES,
+    MotionTable,
+    Plan,
+    below_floor,
+    gather,
+    plan,
+    travel,
+)
+from olp.trajectory import LineLaws, Segment, TimeLaw
 
 if TYPE_CHECKING:
     from olp.passes.pipeline import BuildOptions
 
 
 FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+
+
+class Times:
+    """What the timers found, one row per instruction (n,): ``duration`` s, ``length`` m of TCP
+    travel, the time law ``law`` (an index into :attr:`laws`, -1: none) and the row's window
+    ``start``..``end`` s of it; ``timed``: rows a timer filled (the others keep what they had).
+    Laws are objects (a joint move's, a chain's) or, for the straight lines, one
+    :class:`~olp.trajectory.LineLaws` of arrays."""
+
+    def __init__(self, n: int) -> None:
+        self.duration = np.zeros(n)
+        self.length = np.zeros(n)
+        self.law = np.full(n, -1, dtype=np.int64)
+        self.start = np.zeros(n)
+        self.end = np.zeros(n)
+        self.timed = np.zeros(n, dtype=bool)
+        self.objects: list[TimeLaw] = []
+        self.lines: LineLaws | None = None
+
+    def add_law(self, law: TimeLaw) -> int:
+        self.objects.append(law)
+        return len(self.objects) - 1
+
+    @property
+    def laws(self) -> Sequence[TimeLaw]:
+        return _Laws(self.objects, self.lines)
+
+
+class _Laws(Sequence[TimeLaw]):
+    """The object laws, then the line laws."""
+
+    def __init__(self, objects: list[TimeLaw], lines: LineLaws | None) -> None:
+        self.objects, self.lines = objects, lines
+
+    def __len__(self) -> int:
+        return len(self.objects) + (0 if self.lines is None else len(self.lines))
+
+    @overload
+    def __getitem__(self, k: int) -> TimeLaw: ...
+
+    @overload
+    def __getitem__(self, k: slice) -> Sequence[TimeLaw]: ...
+
+    def __getitem__(self, k: int | slice) -> TimeLaw | Sequence[TimeLaw]:
+        if isinstance(k, slice):
+            return [self[i] for i in range(*k.indices(len(self)))]
+        if k < len(self.objects):
+            return self.objects[k]
+        assert self.lines is not None
+        return self.lines[k - len(self.objects)]
+
+    def __iter__(self) -> Iterator[TimeLaw]:
+        return (self[k] for k in range(len(self)))
 
 
 def time_program(
@@ -46,54 +121,250 @@ def time_program(
     be timed keeps duration 0 and adds an ``error`` (kind ``timing``). Never raises on a bad
     program.
     """
-    lengths = tcp_lengths(compiled)
-    units = plan_units(compiled, lengths)
-    context = Context(compiled, time_table(other_times), options or TimingOptions(), lengths)
-    steps, found = time_units(context, units)
-    found += _overflow(steps)
+    table = MotionTable.of(compiled)
+    lengths = travel(table, compiled.station.robot)
+    corners = plan(table, lengths)
+    times = Times(table.size)
+    opts = options or TimingOptions()
+    time_fixed(table, time_table(other_times), times)
+    found = time_joints(table, lengths, times)
+    found += time_paths(table, lengths, corners, opts, times)
+    found.sort(key=lambda d: d.index if d.index is not None else -1)
+    found += _overflow(compiled, times.duration)
     return dataclasses.replace(
         compiled,
-        steps=tuple(steps),
-        diagnostics=compiled.diagnostics + tuple(found) + tuple(zone_stops(compiled, units)),
+        steps=write_back(compiled, times),
+        diagnostics=compiled.diagnostics + tuple(found) + tuple(zone_stops(table, corners)),
     )
 
 
-def _overflow(steps: Sequence[Step]) -> list[Diagnostic]:
+def time_fixed(table: MotionTable, times: Mapping[str, float], out: Times) -> None:
+    """Rows that are not resolved motions: their time from the time table (an unresolved
+    motion: 0)."""
+    for i in np.flatnonzero((table.kind == FIXED) | (table.kind == COMMENT)).tolist():
+        step = table.compiled.steps[i] if not table.motion[i] else None
+        out.duration[i] = 0.0 if step is None else fixed_time(step.instruction, times)
+        out.timed[i] = True
+
+
+def time_joints(table: MotionTable, lengths: FloatArray, out: Times) -> list[Diagnostic]:
+    """Joint moves, one Ruckig profile each."""
+    robot, found = table.compiled.station.robot, []
+    for i in np.flatnonzero(table.kind == JOINT).tolist():
+        q0, q1 = table.q[table.lo[i]], table.q[table.hi[i]]
+        try:
+            profile = ptp.ptp_profile(
+                q0, q1, robot, float(table.joint[i]), float(table.joint_acceleration[i])
+            )
+        except TimingError as exc:
+            found.append(Diagnostic("error", "timing", str(exc), _span(table.compiled.steps, i), i))
+            continue
+        _fill(out, np.array([i]), out.add_law(profile), np.array([0.0, profile.duration]))
+        out.length[i] = lengths[i]
+    return found
+
+
+def time_paths(
+    table: MotionTable,
+    lengths: FloatArray,
+    corners: Plan,
+    options: TimingOptions,
+    out: Times,
+) -> list[Diagnostic]:
+    """Path moves: the stop-to-stop ones along straight joint lines in closed form, the other
+    chains by the path solver."""
+    sizes = corners.sizes
+    firsts = corners.rows[corners.bounds[:-1]]
+    lone = (sizes == 1) & ~below_floor(table, firsts)  # a too-slow move: the chain timer says so
+    done = np.zeros(sizes.size, dtype=bool)
+    if options.straight_lines and np.any(lone):
+        done[lone] = time_lines(table, lengths, firsts[lone], options, out)
+    return time_chains(table, corners, np.flatnonzero(~done), options, out)
+
+
+def time_lines(
+    table: MotionTable,
+    lengths: FloatArray,
+    rows: IntArray,
+    options: TimingOptions,
+    out: Times,
+) -> NDArray[np.bool_]:
+    """Time stop-to-stop path moves ``rows`` that run along a straight joint line in closed
+    form, all at once; returns which rows were timed (the others: not straight, or an error
+    bound above ``line_tolerance``)."""
+    q, sizes = gather(table, rows)
+    straight = straight_samples(q, sizes, options.line_deviation_rad)
+    rows = rows[straight]
+    q0, q1 = table.q[table.lo[rows]], table.q[table.hi[rows]]
+    robot = table.compiled.station.robot
+    tools = table.tools[table.tool[rows]]
+    profiles = line_profiles(q0, q1, robot, tools, table.linear[rows], table.angular[rows])
+    ok = profiles.excess <= options.line_tolerance
+    rows = rows[ok]
+    out.lines = LineLaws(
+        q0[ok], q1[ok], profiles.accel[ok], profiles.ramp[ok], profiles.duration[ok]
+    )
+    out.duration[rows] = out.end[rows] = profiles.duration[ok]
+    out.start[rows] = 0.0
+    out.length[rows] = lengths[rows]
+    # LineLaws come after the object laws, whose count is known only at the end: offset later.
+    out.law[rows] = -2 - np.arange(rows.size)
+    out.timed[rows] = True
+    timed = np.zeros(straight.size, dtype=bool)
+    timed[np.flatnonzero(straight)[ok]] = True
+    return timed
+
+
+def time_chains(
+    table: MotionTable, corners: Plan, chains: IntArray, options: TimingOptions, out: Times
+) -> list[Diagnostic]:
+    """Chains ``chains`` of path moves: their geometry one by one, their time laws by
+    ``options.solver`` all at once."""
+    robot, steps = table.compiled.station.robot, table.compiled.steps
+    found: list[Diagnostic] = []
+    posed = []
+    for c in chains.tolist():
+        rows = corners.chain(c)
+        slow = np.flatnonzero(below_floor(table, rows))
+        if slow.size:
+            found.append(_too_slow(table, int(rows[slow[0]])))
+            continue
+        q, sizes = gather(table, rows)
+        tool = table.tools[table.tool[rows[0]]]
+        geometry = joined_geometry(
+            q, sizes, robot, tool, corners.blend[rows[:-1]], options.blend_samples
+        )
+        if geometry.s[-1] <= 0.0:  # no joint moves: the TCP stays put
+            out.duration[rows] = out.length[rows] = 0.0
+            out.timed[rows] = True
+            continue
+        problem = path_problem(geometry, tool, table.linear[rows], table.angular[rows], options)
+        posed.append((rows, geometry, problem))
+    speeds = PATH_SOLVERS[options.solver]([problem for _, _, problem in posed], robot)
+    for (rows, geometry, problem), sd in zip(posed, speeds, strict=True):
+        try:
+            law = time_law(problem, sd)
+        except TimingError as exc:
+            first = int(rows[0])
+            found.append(Diagnostic("error", "timing", str(exc), _span(steps, first), first))
+            continue
+        _fill(out, rows, out.add_law(law), law.time_at(geometry.boundaries))
+        out.length[rows] = geometry.lengths
+    return found
+
+
+def _fill(out: Times, rows: IntArray, law: int, edges: FloatArray) -> None:
+    """Rows ``rows`` share law ``law``, row k from ``edges[k]`` to ``edges[k + 1]`` s."""
+    out.law[rows] = law
+    out.start[rows], out.end[rows] = edges[:-1], edges[1:]
+    out.duration[rows] = edges[1:] - edges[:-1]
+    out.timed[rows] = True
+
+
+def _too_slow(table: MotionTable, i: int) -> Diagnostic:
+    """The error for a path move whose programmed speed is below :data:`MIN_PATH_SPEED`."""
+    linear, angular = float(table.linear[i]), float(table.angular[i])
+    which, value, unit = (
+        ("TCP speed", linear * 1000, "mm/s")
+        if linear < MIN_PATH_SPEED
+        else ("orientation speed", float(np.degrees(angular)), "°/s")
+    )
+    msg = (
+        f"the programmed {which} of {value:.3g} {unit} is too low to time (the slowest olp "
+        f"times is {MIN_PATH_SPEED:g} m/s or rad/s)"
+    )
+    return Diagnostic("error", "timing", msg, _span(table.compiled.steps, i), i)
+
+
+def write_back(compiled: CompiledProgram, times: Times) -> Sequence[Step]:
+    """The steps of ``compiled`` with what the timers found: ordinary steps replaced, blocks
+    given arrays."""
+    offset = len(times.objects)
+    law = np.where(times.law <= -2, offset - 2 - times.law, times.law)
+    laws = times.laws
+    items: list[Step | PathBlock] = []
+    for item in items_of(compiled.steps):
+        if isinstance(item, PathBlock):
+            items.append(_block(item, times, law, laws))
+        elif times.timed[item.index]:
+            i = item.index
+            segment = None
+            if law[i] >= 0:
+                segment = Segment(laws[int(law[i])], float(times.start[i]), float(times.end[i]))
+            elif is_motion(item.instruction):
+                segment = item.trajectory
+            items.append(
+                dataclasses.replace(
+                    item,
+                    duration=float(times.duration[i]),
+                    path_length=float(times.length[i]),
+                    trajectory=segment,
+                )
+            )
+        else:
+            items.append(item)
+    return make_steps(items)
+
+
+def _block(block: PathBlock, times: Times, law: IntArray, laws: Sequence[TimeLaw]) -> PathBlock:
+    rows = slice(block.start, block.stop)
+    timed = times.timed[rows]
+    zeros = np.zeros(len(block))
+    old = block.durations if block.durations is not None else zeros
+    old_lengths = block.lengths if block.lengths is not None else zeros
+    trajectories = None
+    if np.any(law[rows] >= 0):
+        trajectories = RowTrajectories(
+            laws, law[rows].copy(), times.start[rows].copy(), times.end[rows].copy()
+        )
+    return dataclasses.replace(
+        block,
+        durations=np.where(timed, times.duration[rows], old),
+        lengths=np.where(timed, times.length[rows], old_lengths),
+        trajectories=trajectories,
+    )
+
+
+def _overflow(compiled: CompiledProgram, durations: FloatArray) -> list[Diagnostic]:
     """An error at the instruction where the running cycle time stops being a finite number
     (each duration is finite, their sum need not be: two waits of 1e308 s)."""
     with np.errstate(over="ignore"):
-        total = np.cumsum([step.duration for step in steps])
+        total = np.cumsum(durations)
     bad = np.flatnonzero(~np.isfinite(total))
     if bad.size == 0:
         return []
-    step = steps[int(bad[0])]
+    i = int(bad[0])
     msg = "the cycle time up to here exceeds the largest number olp can represent"
-    return [Diagnostic("error", "timing", msg, step.instruction.span, step.index)]
+    return [Diagnostic("error", "timing", msg, _span(compiled.steps, i), i)]
 
 
-def time_units(context: Context, units: Sequence[Unit]) -> tuple[list[Step], list[Diagnostic]]:
-    steps = list(context.compiled.steps)
-    lines, rest = time_lines(context, units)
-    chains, found = time_chains(context, [u for u in rest if u.kind == "path"])
-    for step in lines + chains:
-        steps[step.index] = step
-    for unit in rest:
-        if unit.kind == "path":
-            continue
-        try:
-            for step in _UNIT_TIMERS[unit.kind](unit, context):
-                steps[step.index] = step
-        except TimingError as exc:
-            first = steps[unit.indices[0]].instruction
-            found.append(Diagnostic("error", "timing", str(exc), first.span, unit.indices[0]))
-    return steps, sorted(found, key=lambda d: d.index if d.index is not None else -1)
+def zone_stops(table: MotionTable, corners: Plan) -> list[Diagnostic]:
+    """An info diagnostic for every zone that the model times as an exact stop although a
+    motion follows (after the last motion the robot stops anyway)."""
+    motions = np.flatnonzero(table.motion)
+    if motions.size == 0:
+        return []
+    stops = (table.kind >= JOINT) & (table.zone > 0) & (corners.blend <= 0)
+    stops[motions[-1]] = False
+    found = []
+    for i in np.flatnonzero(stops).tolist():
+        msg = (
+            f"zone of {table.zone[i] * 1000:g} mm timed as an exact stop "
+            f"({_STOP_REASON[KIND_NAMES[int(table.kind[i])]]}): the cycle time is an upper "
+            "bound here"
+        )
+        found.append(Diagnostic("info", "zone_stop", msg, _span(table.compiled.steps, i), i))
+    return found
 
 
-_UNIT_TIMERS: dict[str, Callable[[Unit, Context], list[Step]]] = {
-    "fixed": time_fixed,
-    "joint": time_joint,
+_PATH_STOP = "the next motion is not a path move with the same tool, or the corner is too short"
+
+
+_STOP_REASON = {
+    "joint": "olp does not model joint-move blending",
+    "linear": _PATH_STOP,
+    "circular": _PATH_STOP,
 }
-"""Timers of single units; path units are timed together (:func:`time_chains`)."""
 
 
 def timing_pass(compiled: CompiledProgram, options: BuildOptions) -> CompiledProgram:

@@ -3,35 +3,16 @@ docstring)."""
 
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 from numpy.typing import NDArray
 from ruckig import InputParameter, Result, Ruckig, RuckigError, Synchronization, Trajectory
 
-from olp.compiled import Step
-from olp.ir import JointMove
 from olp.passes.timing.lines import trapezoid
-from olp.passes.timing.plan import Context, TimingError, Unit
+from olp.passes.timing.plan import TimingError
 from olp.station.model import Robot
-from olp.trajectory import JerkProfile, Segment
+from olp.trajectory import JerkProfile
 
 FloatArray = NDArray[np.float64]
-
-
-def time_joint(unit: Unit, context: Context) -> list[Step]:
-    step = context.compiled.steps[unit.indices[0]]
-    ins = step.instruction
-    assert isinstance(ins, JointMove) and step.path is not None
-    robot = context.compiled.station.robot
-    profile = ptp_profile(
-        step.path[0], step.path[-1], robot, ins.speed.joint, ins.speed.joint_acceleration
-    )
-    segment = Segment(profile, 0.0, profile.duration)
-    length = context.lengths[step.index]
-    return [
-        dataclasses.replace(step, duration=profile.duration, path_length=length, trajectory=segment)
-    ]
 
 
 def ptp_profile(

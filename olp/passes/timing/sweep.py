@@ -1,5 +1,5 @@
 """Speed sweeps: cycle times over a grid of TCP speeds and joint speeds, each timing reusing
-the program's plan."""
+the program's table and plan."""
 
 from __future__ import annotations
 
@@ -11,8 +11,9 @@ from numpy.typing import NDArray
 
 from olp.compiled import CompiledProgram
 from olp.ir import CircularMove, JointMove, LinearMove
-from olp.passes.timing.plan import Context, TimingOptions, plan_units, tcp_lengths, time_table
-from olp.passes.timing.program import time_units
+from olp.passes.timing.plan import TimingOptions, time_table
+from olp.passes.timing.program import Times, time_fixed, time_joints, time_paths
+from olp.passes.timing.table import JOINT, MotionTable, plan, travel
 
 FloatArray = NDArray[np.float64]
 
@@ -50,26 +51,28 @@ def speed_sweep(
     Path chains never contain joint moves, so the path time depends only on the linear speed and
     the joint-move time only on the joint speed: L + J timings give the L x J table.
     """
-    lengths = tcp_lengths(compiled)
-    units = plan_units(compiled, lengths)
-    context = Context(compiled, time_table(other_times), options or TimingOptions(), lengths)
-    total = len(linear_speeds) + len(joint_speeds)
-    parts: list[FloatArray] = []
-    for kind, values, key in (("path", linear_speeds, "linear"), ("joint", joint_speeds, "joint")):
-        chosen = [u for u in units if u.kind == kind]
-        sums = []
-        for value in values:
-            retimed = dataclasses.replace(
-                context, compiled=override_speeds(compiled, **{key: value})
-            )
-            steps, found = time_units(retimed, chosen)
-            picked = [steps[i].duration for u in chosen for i in u.indices]
-            sums.append(np.nan if found else float(np.sum(picked)))
-            if progress is not None:
-                progress(len(parts) * len(linear_speeds) + len(sums), total)
-        parts.append(np.array(sums, dtype=np.float64))
-    fixed = [u for u in units if u.kind == "fixed"]
-    steps, _ = time_units(context, fixed)
-    rest = float(sum(steps[i].duration for u in fixed for i in u.indices))
-    table: FloatArray = parts[0][:, None] + parts[1][None, :] + rest
-    return table
+    table = MotionTable.of(compiled)
+    lengths = travel(table, compiled.station.robot)
+    corners = plan(table, lengths)
+    opts = options or TimingOptions()
+    total, done = len(linear_speeds) + len(joint_speeds), 0
+
+    def timed(value: float | None, joint: bool) -> float:
+        nonlocal done
+        times = Times(table.size)
+        if joint:
+            found = time_joints(table.with_speeds(None, value), lengths, times)
+        else:
+            found = time_paths(table.with_speeds(value, None), lengths, corners, opts, times)
+        done += 1
+        if progress is not None:
+            progress(done, total)
+        rows = table.kind == JOINT if joint else table.path
+        return np.nan if found else float(np.sum(times.duration[rows]))
+
+    paths = np.array([timed(value, False) for value in linear_speeds], dtype=np.float64)
+    joints = np.array([timed(value, True) for value in joint_speeds], dtype=np.float64)
+    fixed = Times(table.size)
+    time_fixed(table, time_table(other_times), fixed)
+    out: FloatArray = paths[:, None] + joints[None, :] + float(np.sum(fixed.duration))
+    return out

@@ -37,7 +37,8 @@ def tcp_positions(robot: Robot, joints: FloatArray, tools: FloatArray) -> FloatA
 
 
 FK_ROWS = 1 << 18
-"""Joint samples per forward-kinematics batch in :func:`tcp_lengths` (bounds memory)."""
+"""Joint samples per forward-kinematics batch in :func:`olp.passes.timing.table.travel`
+(bounds memory)."""
 
 
 def tcp_rates(

@@ -1,0 +1,127 @@
+"""Full builds of a helix toolpath (CSV) on every post, as a new user runs them, with a reference
+from the same run: the targets of "a million points in a minute".
+
+Each build is ``olp build stations/kr6_milling_cell.yaml helix.csv --frame table --orientation
+180,0,180 --post P`` with the default checks, collisions and timing, in a fresh interpreter with
+one BLAS/OpenMP thread; its wall time and peak resident memory (Linux's VmHWM) are the child's
+own. Also timed: ``olp --help`` and ``olp posts`` (the fixed cost of starting), and a 1k-point
+build. The reference is the naive approach the issue names: olp's own single-pose inverse
+kinematics called once per point in a Python loop, on the same points, in the same run.
+
+    python benchmarks/full_builds.py [POINTS] [--posts kuka,abb,ur,fanuc]
+
+Last lines: ``name: value unit``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+CELL = REPO / "stations" / "kr6_milling_cell.yaml"
+ORIENTATION = "180,0,180"
+
+CHILD = r"""
+import runpy, sys, time
+start = time.perf_counter()
+sys.argv = ["olp", *sys.argv[1:]]
+code = 0
+try:
+    runpy.run_module("olp", run_name="__main__")
+except SystemExit as exc:
+    code = exc.code or 0
+wall = time.perf_counter() - start
+peak = 0.0
+for line in open("/proc/self/status"):
+    if line.startswith("VmHWM:"):
+        peak = int(line.split()[1]) / 1024
+print(f"@@ {wall:.3f} {peak:.1f} {code}", file=sys.stderr)
+"""
+
+
+def helix(points: int, path: Path) -> None:
+    """A helix of ``points`` rows (mm, in the table frame) that the KR 6 cell reaches."""
+    t = np.linspace(0.0, 40.0 * np.pi, points)
+    xyz = np.c_[100 + 60 * np.cos(t), 60 * np.sin(t), 20 + np.linspace(0.0, 30.0, points)]
+    np.savetxt(path, xyz, fmt="%.4f", delimiter=",", header="x,y,z", comments="")
+
+
+def run_olp(*args: str) -> tuple[float, float, int]:
+    """Wall time (s), peak memory (MB) and exit code of ``olp ARGS`` in a fresh interpreter."""
+    env = {**os.environ, "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "CI": "1"}
+    done = subprocess.run(
+        [sys.executable, "-c", CHILD, *args], capture_output=True, text=True, env=env, check=False
+    )
+    line = next((x for x in done.stderr.splitlines() if x.startswith("@@ ")), None)
+    if line is None:
+        raise SystemExit(f"olp {' '.join(args)} failed:\n{done.stderr[-2000:]}")
+    wall, peak, code = line.split()[1:]
+    return float(wall), float(peak), int(code)
+
+
+def naive_ik_seconds(points: int) -> float:
+    """Seconds for olp's single-pose IK called once per helix point (the naive loop)."""
+    import olp
+
+    station = olp.load_station(CELL)
+    robot = station.robot
+    table, tool = station.frames["table"], station.tools["spindle"]
+    assert table.pose is not None and tool.pose is not None
+    t = np.linspace(0.0, 40.0 * np.pi, points)
+    rotation = np.diag([-1.0, 1.0, -1.0])  # 180, 0, 180: the tool points down
+    flange_in_tcp = np.linalg.inv(tool.pose)
+    start = time.perf_counter()
+    for k in range(points):
+        pose = np.eye(4)
+        pose[:3, :3] = rotation
+        pose[:3, 3] = [0.1 + 0.06 * np.cos(t[k]), 0.06 * np.sin(t[k]), 0.02 + 0.03 * k / points]
+        robot.solve(table.pose @ pose @ flange_in_tcp)
+    return time.perf_counter() - start
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("points", nargs="?", type=int, default=100_000)
+    parser.add_argument("--posts", default="kuka,abb,ur,fanuc")
+    args = parser.parse_args()
+    posts = args.posts.split(",")
+    results: list[tuple[str, float, str]] = []
+    with tempfile.TemporaryDirectory() as scratch:
+        folder = Path(scratch)
+        for label, count in (("1k", 1000), ("n", args.points)):
+            helix(count, folder / f"{label}.csv")
+        for command in (("--help",), ("posts",)):
+            wall, _, _ = run_olp(*command)
+            results.append((f"olp_{command[0].strip('-')}_seconds", wall, "s"))
+        for post in posts:
+            for label in ("1k", "n"):
+                wall, peak, code = run_olp(
+                    "build", str(CELL), str(folder / f"{label}.csv"), "--frame", "table",
+                    "--orientation", ORIENTATION, "--post", post, "-o",
+                    str(folder / f"out_{post}_{label}"), "--quiet",
+                )  # fmt: skip
+                if code != 0:
+                    raise SystemExit(f"olp build --post {post} on {label} exited {code}")
+                tag = "1k" if label == "1k" else f"{args.points}"
+                results.append((f"{post}_{tag}_build_seconds", wall, "s"))
+                results.append((f"{post}_{tag}_peak_memory", peak, "MB"))
+    reference = naive_ik_seconds(args.points)
+    results.append((f"naive_ik_loop_{args.points}_seconds", reference, "s"))
+    for post in posts:
+        wall = next(v for n, v, _ in results if n == f"{post}_{args.points}_build_seconds")
+        results.append((f"{post}_build_vs_naive_ik_loop", wall / reference, "x"))
+    print(f"points: {args.points}")
+    for name, value, unit in results:
+        print(f"{name}: {value:.3f} {unit}")
+
+
+if __name__ == "__main__":
+    main()
