@@ -96,9 +96,11 @@ What is lowered
 Nothing is dropped silently: every statement olp recognised but did not lower is in
 :attr:`KrlResult.ignored` with the reason (also those of the data lists; the frontend reports
 the program's own as warnings). Statements that matter to the controller but that olp does not
-model (motion parameters such as ``$ACC.CP`` and ``$ORI_TYPE``, assignments that call functions,
-``SET_CD_PARAMS``, ``PULSE``, ``ON_ERROR_PROCEED``, ``RESUME``) are kept in the program as
-:class:`olp.ir.Verbatim`: the KRL post writes them back, other posts stop on them.
+model (motion parameters such as ``$ACC.CP``, ``$VEL.ORI1``, ``$ADVANCE``; ``SET_CD_PARAMS``,
+``PULSE``, ``HALT``, ``BRAKE``, ``CONTINUE``, ``ON_ERROR_PROCEED``, ``RESUME``, motions to
+``$POS_ACT``) are kept in the program as :class:`olp.ir.Verbatim`: the KRL post writes them
+back, other posts stop on them. ``$ORI_TYPE``/``$CIRC_TYPE`` are motion settings (the arcs'
+orientation rule); for linear moves olp notes at each one that it does not model them.
 
 Text the grammar does not accept, and values olp needs but cannot use, raise
 :class:`olp.errors.ParseError` with file, line, column, what was expected and the offending text.

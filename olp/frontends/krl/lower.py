@@ -671,7 +671,16 @@ class _Lowering(Motions):
 
 
 Body = tuple[ir.Node, ...]
-_STATE_FIELDS = ("speed", "vel_axis", "acc_axis", "cdis_mm", "tool", "frame")
+_STATE_FIELDS = (
+    "speed",
+    "vel_axis",
+    "acc_axis",
+    "cdis_mm",
+    "tool",
+    "frame",
+    "ori_type",
+    "circ_type",
+)
 _SETTING_NAMES = {
     "speed": "the speed",
     "vel_axis": "$VEL_AXIS",
@@ -679,6 +688,8 @@ _SETTING_NAMES = {
     "cdis_mm": "$APO.CDIS",
     "tool": "$TOOL",
     "frame": "$BASE",
+    "ori_type": "$ORI_TYPE",
+    "circ_type": "$CIRC_TYPE",
 }
 
 

@@ -179,8 +179,6 @@ KEPT_SYSTEM_VARIABLES = frozenset(
         "$ACC.ORI2",
         "$VEL.ORI1",
         "$VEL.ORI2",
-        "$ORI_TYPE",
-        "$CIRC_TYPE",
         "$APO.CPTP",
         "$APO.CORI",
         "$APO.CVEL",
