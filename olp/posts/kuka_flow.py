@@ -31,6 +31,8 @@ _BINARY = {
 }
 _UNARY = {"not": "NOT ", "bit_not": "B_NOT ", "-": "-", "+": "+"}
 _IDENTIFIER = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]*\Z")
+INT_MIN, INT_MAX = -(2**31), 2**31 - 1
+"""KRL's INT is a 32-bit signed integer."""
 
 
 def krl_expr(expr: ir.Expr | None, nested: bool = False) -> str:
@@ -137,6 +139,8 @@ def _constant_problem(expr: ir.Constant) -> str | None:
         return f"#{value} is not a KRL enumeration value"
     if isinstance(value, float) and not math.isfinite(value):
         return f"{value} is not a number KRL can hold"
+    if isinstance(value, int) and not isinstance(value, bool) and not INT_MIN <= value <= INT_MAX:
+        return f"{value} is outside KRL's INT range ({INT_MIN} .. {INT_MAX})"
     bad_text = isinstance(value, str) and not expr.enum and ('"' in value or _has_control(value))
     if bad_text:
         return f"the text {value!r} holds a double quote or a control character"

@@ -108,3 +108,12 @@ def test_text_that_krl_cannot_hold_is_an_error(station: object) -> None:
         (d.kind, d.span.line if d.span else 0) for d in result.diagnostics if d.severity == "error"
     ]
     assert errors == [("flow", 4)] and not result.files
+
+
+def test_numbers_krl_cannot_hold_are_errors_not_crashes(station: object, tmp_path: Path) -> None:
+    src = tmp_path / "big.src"
+    src.write_text("DEF big( )\nDECL INT n\nn = " + "9" * 400 + "\nm = 3000000000\nEND\n")
+    result = olp.build(station, src, collisions=None)
+    found = [d for d in result.diagnostics if d.severity == "error"]
+    assert [(d.kind, d.span.line if d.span else 0) for d in found] == [("flow", 3), ("flow", 4)]
+    assert not result.files

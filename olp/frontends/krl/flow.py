@@ -10,6 +10,7 @@ with a constant ``n``, and a one-bit SIGNAL of an input, become :class:`olp.ir.D
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Iterable, Iterator
 
 from olp import ir
@@ -59,7 +60,8 @@ def to_expr(expr: Expr | None, input_of: InputOf) -> ir.Expr | None:
 def _convert(expr: Expr, input_of: InputOf) -> ir.Expr:
     span = expr.span
     if isinstance(expr, Num):
-        value: bool | int | float | str = int(expr.value) if expr.is_int else expr.value
+        whole = expr.is_int and math.isfinite(expr.value)  # '9' * 400 reads as infinity
+        value: bool | int | float | str = int(expr.value) if whole else expr.value
         return ir.Constant(value=value, span=span)
     if isinstance(expr, Bool | Text | Bits):
         return ir.Constant(value=expr.value, span=span)
