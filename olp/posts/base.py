@@ -29,7 +29,9 @@ What every post checks (:meth:`Post.check`), so that no brand can forget it:
 * digital I/O numbers within the controller's range (``IO_RANGE``, ``io_range``);
 * a station robot of another brand than the post's (a warning, ``foreign_robot``);
 * a :class:`~olp.ir.Verbatim` statement of another language than the post's ``VERBATIM`` is an
-  error naming its line (``verbatim``).
+  error naming its line (``verbatim``); with the template folder's option
+  ``foreign_verbatim: drop`` it is left out with a warning showing its text
+  (``verbatim_dropped``).
 
 Numbers are written through :meth:`Post.number` with a quantity of ``NUMBERS``
 (:mod:`olp.posts.numbers`): a value the controller cannot hold as checked and timed is an error on
@@ -408,15 +410,21 @@ class Post:
     def _verbatim_checks(self, step: Step, ins: Any) -> list[Diagnostic]:
         """A statement kept as source text goes out unchanged to its own language only; it was
         checked to be one line when made, so it cannot start another statement."""
-        if ins.language != self.VERBATIM:
-            msg = (
-                f"{ins.language.upper()} statement {_quote(ins.text)} (line {ins.span.line}) is "
-                f"kept verbatim because olp does not model it ({ins.reason}); the "
-                f"{self.LANGUAGE} post cannot write it"
-            )
-            hint = "write it for this controller by hand, or remove it from the source program"
-            return [_error("verbatim", msg, step, hint=hint)]
-        return self._encoding_checks(step, "verbatim", ins.text)
+        if ins.language == self.VERBATIM:
+            return self._encoding_checks(step, "verbatim", ins.text)
+        what = f"{ins.language.upper()} statement {_quote(ins.text)} (line {ins.span.line})"
+        if self.options.get("foreign_verbatim") == "drop":
+            msg = f"{what} is not written: the option foreign_verbatim: drop leaves it out"
+            return [Diagnostic("warning", "verbatim_dropped", msg, ins.span, step.index)]
+        msg = (
+            f"{what} is kept verbatim because olp does not model it ({ins.reason}); the "
+            f"{self.LANGUAGE} post cannot write it"
+        )
+        hint = (
+            "write it for this controller by hand, remove it from the source program, or leave "
+            "it out with a warning: the post option foreign_verbatim: drop (in a copy of the post)"
+        )
+        return [_error("verbatim", msg, step, hint=hint)]
 
     def _call_checks(self, step: Step, name: str, args: Sequence[str]) -> list[Diagnostic]:
         if not self.NAME_RULE.is_legal(name):

@@ -103,3 +103,20 @@ def test_a_motion_to_where_the_robot_is_is_kept_as_written() -> None:
         ("verbatim", "PTP $AXIS_ACT C_PTP", 3),
         ("wait", "", 4),
     ]
+
+
+def test_a_copied_post_may_leave_foreign_lines_out_with_a_warning(
+    station: object, tmp_path: Path
+) -> None:
+    import shutil
+
+    folder = tmp_path / "abb_drop"
+    shutil.copytree(REPO / "posts" / "abb", folder)
+    manifest = folder / "post.yaml"
+    text = manifest.read_text().replace("options:\n", "options:\n  foreign_verbatim: drop\n", 1)
+    manifest.write_text(text)
+    result = build(station, REPO / "examples" / "facing_mill.src", str(folder))
+    assert result.ok and result.files
+    (dropped,) = [d for d in result.diagnostics if d.kind == "verbatim_dropped"]
+    assert dropped.severity == "warning" and "'$ACC.CP = 2.0' (line 12)" in dropped.message
+    assert "ACC.CP" not in "".join(result.files.values())
