@@ -52,7 +52,9 @@ from numpy.typing import ArrayLike
 from olp.diagnostics import Diagnostic
 from olp.errors import PostError
 from olp.ir import ArcOrientation, CartesianTarget
+from olp.ir_flow import FLOW_TYPES, leaves_and_blocks
 from olp.posts.base import Filter, Post
+from olp.posts.kuka_flow import flow_problem, krl_decl, krl_expr
 from olp.posts.numbers import NumberFormat, Storage
 from olp.posts.sandbox import SafeText
 from olp.posts.text import IDENTIFIER, NUMBER, ArgumentRule, NameRule, double_quoted, one_of
@@ -279,6 +281,8 @@ FILTERS: Mapping[str, Filter] = {
     "krl_arc_types": krl_arc_types,
     "krl_ca": krl_ca,
     "krl_rows": krl_rows,
+    "krl_expr": lambda post, expr: krl_expr(expr),
+    "krl_decl": lambda post, step: krl_decl(step),
 }
 
 
@@ -288,6 +292,8 @@ class KukaPost(Post):
     NAME = "kuka"
     VENDOR = "kuka"
     LANGUAGE = "KRL"
+    VERBATIM = "krl"
+    WRITES_FLOW = True
     NAME_RULE = NAME_RULE
     IO_RANGE = (1, 4096)
     CALL_ARGUMENTS = ArgumentRule(
@@ -333,6 +339,16 @@ class KukaPost(Post):
         return _joint_checks(step.index, ins, self.options) + _ambiguity(
             compiled.station.robot, step
         )
+
+    def check_program(self, compiled: CompiledProgram) -> list[Diagnostic]:
+        """* ``flow`` (error): a name or text of a control-flow statement or condition that
+        KRL cannot hold (:func:`olp.posts.kuka_flow.flow_problem`)."""
+        found = []
+        for node in leaves_and_blocks(compiled.program.instructions):
+            if isinstance(node, FLOW_TYPES) and (problem := flow_problem(node)) is not None:
+                message = f"{node.kind.replace('_', ' ')} cannot be written in KRL: {problem}"
+                found.append(Diagnostic("error", "flow", message, node.span))
+        return found
 
 
 def _ambiguity(robot: Any, step: Step) -> list[Diagnostic]:
