@@ -146,7 +146,8 @@ def build(
     diagnostics = notes + compiled.diagnostics
     if not compiled.ok:
         return BuildResult(compiled, writer.name, diagnostics)
-    compiled, prepared = writer.prepare(compiled)
+    # The post walks the steps several times: a toolpath's rows are made into steps once here.
+    compiled, prepared = writer.prepare(compiled.flat())
     diagnostics = diagnostics + tuple(prepared) + tuple(writer.check(compiled))
     if has_errors(diagnostics):
         return BuildResult(compiled, writer.name, diagnostics)
@@ -154,7 +155,7 @@ def build(
 
     with progress.stage("write", len(compiled.steps)):
         try:
-            files = writer.render(compiled, name)
+            files = writer.render(compiled, name, prepared=True)
         except RenderError as exc:
             return BuildResult(compiled, writer.name, diagnostics + exc.diagnostics)
         written: builtins.list[Path] = []

@@ -237,7 +237,7 @@ class CompiledProgram:
         robot's home joints."""
         items: list[Item] = []
         index = 0
-        for node in program.instructions:
+        for node in program.flat_nodes():
             if isinstance(node, LinearPath):
                 items.append(PathBlock(index, node))
                 index += len(node)

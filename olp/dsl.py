@@ -34,6 +34,16 @@ Units and conventions (those of the RoboDK API, whose names robot programmers kn
   for CSV files. ``SolveIK`` keeps RoboDK's meaning: a flange pose in the robot base frame.
 * Inside olp everything is converted to SI at the call; :class:`Mat` never leaves this module.
 
+RoboDK scripts
+--------------
+A script written against RoboDK's API runs unchanged: ``from robolink import *``,
+``from robodk import *`` and the newer ``robodk.robolink`` / ``robodk.robomath`` paths are
+importable inside a program olp runs (:mod:`olp.compat`; ``Robolink()``, ``RDK.Item(name)``
+over the station's named robot, tools, frames, objects and ``targets:``, run modes with
+``TargetReachError``, program items). ``docs/robodk.md`` maps every call to what olp does.
+The class :class:`Robot` below is what both APIs record with; ``help(olp.dsl)`` lists its
+methods.
+
 Questions a program may ask the station (jobs 2 and 6): :meth:`Robot.Joints`,
 :meth:`Robot.Pose`, :meth:`Robot.SolveIK`, :meth:`Robot.MoveL_Test`, :meth:`Robot.MoveJ_Test`
 (RoboDK's names and return codes) and :meth:`Robot.canReach` / :meth:`Robot.canMoveL` /
@@ -84,10 +94,16 @@ __all__ = [
     "INSTRUCTION_START_THREAD",
     "AddFrame",
     "AddTarget",
+    "DslError",
+    "Feasibility",
+    "FrameItem",
     "Mat",
     "Offset",
     "Pose",
     "RelTool",
+    "Robot",
+    "Target",
+    "ToolItem",
     "acos",
     "asin",
     "atan2",
@@ -473,6 +489,8 @@ class Feasibility:
     ok: bool
     reason: str = ""
     kind: str = ""
+    count: int = 0
+    """How many error diagnostics the move raised (e.g. colliding pairs)."""
 
     def __bool__(self) -> bool:
         return self.ok
@@ -505,6 +523,10 @@ def _session() -> Session:
     return session
 
 
+session = _session
+"""The running program's :class:`~olp.frontends.dsl.Session` (for :mod:`olp.compat`)."""
+
+
 # ------------------------------------------------------------------------------------------------
 # The robot: motions, settings and questions to the station
 
@@ -515,10 +537,16 @@ characters: linear in the text (``\\s*;?\\s*`` backtracks cubically on a long ru
 
 
 class Robot:
-    """The recorder behind ``robot`` (RoboDK's ``Item`` methods for a robot or program)."""
+    """The recorder behind ``robot`` (RoboDK's ``Item`` methods for a robot or program).
 
-    def __init__(self, session: Session) -> None:
+    ``instructions``: the list it records into (default: the session's program; a RoboDK
+    program item has its own).
+    """
+
+    def __init__(self, session: Session, instructions: list[ir.Instruction] | None = None) -> None:
         self._s = session
+        self._sink = session.instructions if instructions is None else instructions
+        self.check_collisions = False
         station = session.station
         self._tool: ir.Tool = (
             next(iter(station.tools.values()), ir.FLANGE) if station else ir.FLANGE
@@ -528,22 +556,51 @@ class Robot:
         self._zone = ir.FINE
         self._sim: _Simulation | None = None
 
+    def _record(self, instruction: ir.Instruction) -> None:
+        self._sink.append(instruction)
+
     # ---- motions
     def MoveJ(self, target: Any, blocking: bool = True) -> None:
         """Joint move to a pose (Mat), joints (degrees), a :class:`Target` or a target name."""
-        self._s.record(ir.JointMove(target=self._target(target, "MoveJ"), **self._state()))
+        self._record(ir.JointMove(target=self._target(target, "MoveJ"), **self._state()))
 
     def MoveL(self, target: Any, blocking: bool = True) -> None:
         """Linear move to a pose (Mat), joints (degrees), a :class:`Target` or a target name."""
-        self._s.record(ir.LinearMove(target=self._target(target, "MoveL"), **self._state()))
+        self._record(ir.LinearMove(target=self._target(target, "MoveL"), **self._state()))
+
+    def motion(
+        self,
+        kind: type[ir.JointMove] | type[ir.LinearMove],
+        target: ir.Target,
+        frame: ir.Frame | None = None,
+    ) -> ir.JointMove | ir.LinearMove:
+        """The move ``kind`` to ``target`` with the current settings (``frame``: another frame
+        than the active one, e.g. a target item's own), not recorded yet."""
+        state = self._state()
+        if frame is not None:
+            state["frame"] = frame
+        return kind(target=target, **state)
+
+    def circular(
+        self, via: ir.Target, end: ir.Target, frame: ir.Frame | None = None
+    ) -> ir.CircularMove:
+        """A circular move through ``via`` to ``end`` with the current settings, not recorded."""
+        if not isinstance(via, ir.CartesianTarget):
+            raise DslError("MoveC: the via point must be a pose, not joints")
+        state = self._state()
+        if frame is not None:
+            state["frame"] = frame
+        return ir.CircularMove(target=end, via=via, **state)
+
+    def record(self, instruction: ir.Instruction) -> None:
+        """Append ``instruction`` to this recorder's program."""
+        self._record(instruction)
 
     def MoveC(self, target1: Any, target2: Any, blocking: bool = True) -> None:
         """Circular move through ``target1`` to ``target2`` (both Cartesian)."""
         via = self._target(target1, "MoveC")
         end = self._target(target2, "MoveC")
-        if not isinstance(via, ir.CartesianTarget):
-            raise DslError("MoveC: the via point must be a pose, not joints")
-        self._s.record(ir.CircularMove(target=end, via=via, **self._state()))
+        self._record(self.circular(via, end))
 
     def _state(self) -> dict[str, Any]:
         return {
@@ -662,7 +719,8 @@ class Robot:
 
     # ---- tool and frame
     def setPoseTool(self, tool: Any) -> Robot:
-        """The active tool: a station tool name, a :class:`ToolItem` or a TCP pose (mm)."""
+        """The active tool: a station tool name or number, a :class:`ToolItem` or a TCP pose
+        (mm; it gets the next free tool number)."""
         self._tool = self._tool_of(tool)
         return self
 
@@ -677,7 +735,9 @@ class Robot:
 
     def AddTool(self, tool_pose: Mat, tool_name: str = "New TCP") -> ToolItem:
         """A new tool (TCP pose in the flange frame, mm); it becomes the active tool."""
-        item = ToolItem(ir.Tool(name=str(tool_name), pose=self._rigid(tool_pose, "AddTool")))
+        name = str(tool_name)
+        pose = self._rigid(tool_pose, "AddTool")
+        item = ToolItem(ir.Tool(name=name, pose=pose, number=self._s.tool_number(name)))
         self._tool = item.tool
         return item
 
@@ -694,16 +754,51 @@ class Robot:
             return tool.tool
         if isinstance(tool, str):
             return self._station_item(tool, "tool")
-        line = self._s.span().line
-        return ir.Tool(name=f"tool_l{line}", pose=self._rigid(tool, "setPoseTool"))
+        if isinstance(tool, int | np.integer) and not isinstance(tool, bool):
+            return self._tool_number(int(tool))
+        pose = self._rigid(tool, "setPoseTool")
+        known = self._same_pose(pose, [self._tool, *self._station_tools(), ir.FLANGE])
+        if known is not None:
+            return known
+        name = f"tool_l{self._s.span().line}"
+        return ir.Tool(name=name, pose=pose, number=self._s.tool_number(name))
+
+    def _tool_number(self, number: int) -> ir.Tool:
+        """The station's tool with controller number ``number`` (0: the flange)."""
+        station = self._s.station
+        tools = list(station.tools.values()) if station is not None else []
+        for tool in tools:
+            if tool.number == number:
+                return tool
+        if number == 0:
+            return ir.FLANGE
+        known = ", ".join(f"{t.number} {t.name}" for t in tools if t.number is not None)
+        raise DslError(f"setPoseTool: no tool number {number} (tools: {known or 'none'})")
 
     def _frame_of(self, frame: Any) -> ir.Frame:
         if isinstance(frame, FrameItem):
             return frame.frame
         if isinstance(frame, str):
             return self._station_item(frame, "frame")
-        line = self._s.span().line
-        return ir.Frame(name=f"frame_l{line}", pose=self._rigid(frame, "setPoseFrame"))
+        pose = self._rigid(frame, "setPoseFrame")
+        frames = self._s.station.frames.values() if self._s.station is not None else ()
+        known = self._same_pose(pose, [self._frame, *frames, ir.WORLD])
+        if known is not None:
+            return known
+        return ir.Frame(name=f"frame_l{self._s.span().line}", pose=pose)
+
+    def _station_tools(self) -> list[ir.Tool]:
+        return list(self._s.station.tools.values()) if self._s.station is not None else []
+
+    @staticmethod
+    def _same_pose(pose: FloatArray, items: Sequence[Any]) -> Any:
+        """The first of ``items`` (tools or frames) whose pose is ``pose`` (to 1 µm and 1 µrad):
+        a pose read back from a tool or frame (``robot.setPoseTool(robot.PoseTool())``) keeps
+        that tool or frame, and with it its controller number."""
+        for item in items:
+            if item.pose is not None and np.allclose(item.pose, pose, rtol=0.0, atol=1e-6):
+                return item
+        return None
 
     def _station_item(self, name: str, kind: str) -> Any:
         builtin: Mapping[str, Any] = (
@@ -747,7 +842,7 @@ class Robot:
     # ---- I/O, waits, calls, comments
     def setDO(self, io_var: int | str, io_value: Any) -> None:
         """Set digital output ``io_var`` (a number) to ``io_value`` (1/0, True/False, on/off)."""
-        self._s.record(
+        self._record(
             ir.SetOutput(
                 index=_io_index(io_var, "setDO"),
                 value=_io_value(io_value, "setDO"),
@@ -760,7 +855,7 @@ class Robot:
         (timeout,) = _finite([timeout_ms], "waitDI timeout")
         if timeout >= 0:
             raise DslError("waitDI: a timeout is not supported yet (olp's IR waits without one)")
-        self._s.record(
+        self._record(
             ir.WaitInput(
                 index=_io_index(io_var, "waitDI"),
                 value=_io_value(io_value, "waitDI"),
@@ -777,7 +872,7 @@ class Robot:
                 "Pause() without a time (stop until resumed) is not supported yet; "
                 "give a time in ms"
             )
-        self._s.record(ir.Wait(seconds=ms / 1000.0, span=self._s.span()))
+        self._record(ir.Wait(seconds=ms / 1000.0, span=self._s.span()))
 
     def RunInstruction(self, code: str, run_type: int = INSTRUCTION_CALL_PROGRAM) -> None:
         """A program call (``"SprayOn"``, ``"TCP_On(2)"``) or a comment (``INSTRUCTION_COMMENT``).
@@ -788,7 +883,7 @@ class Robot:
             raise DslError(f"RunInstruction: expected text, got {_describe(code)}")
         span = self._s.span()
         if run_type == INSTRUCTION_COMMENT:
-            self._s.record(ir.Comment(text=code, span=span))
+            self._record(ir.Comment(text=code, span=span))
             return
         if run_type != INSTRUCTION_CALL_PROGRAM:
             raise DslError(
@@ -803,7 +898,7 @@ class Robot:
             )
         name, args = match.group(1), match.group(2)
         values = tuple(a.strip() for a in args.split(",")) if args and args.strip() else ()
-        self._s.record(ir.Call(name=name, args=values, span=span))
+        self._record(ir.Call(name=name, args=values, span=span))
 
     def ProgramStart(self, programname: str, folder: str = "", postprocessor: str = "") -> None:
         """Name the generated program (RoboDK's ``ProgramStart``); folder and post come from
@@ -896,12 +991,31 @@ class Robot:
         return Feasibility(False, "no IK solution inside the joint limits", "unreachable")
 
     def _check_moves(self, start: FloatArray, moves: list[ir.Instruction]) -> Feasibility:
+        return self.try_moves(start, moves)[0]
+
+    def try_moves(
+        self, start: FloatArray, moves: Sequence[ir.Instruction]
+    ) -> tuple[Feasibility, FloatArray | None]:
+        """Whether ``moves`` can run from joints ``start`` (rad), by olp's resolve pass (and its
+        collision check when :attr:`check_collisions`), and the joints at their end (None when
+        they cannot run)."""
         station = self._station("a move test")
         compiled = _resolve_from(station, start, moves)
-        errors = [d for d in compiled.diagnostics if d.severity == "error"]
+        diagnostics = list(compiled.diagnostics)
+        if self.check_collisions and compiled.ok:
+            from olp.passes.collide import check_collisions
+
+            diagnostics += check_collisions(compiled)
+        errors = [d for d in diagnostics if d.severity == "error"]
         if errors:
-            return Feasibility(False, errors[0].message, errors[0].kind)
-        return Feasibility(True)
+            return Feasibility(False, errors[0].message, errors[0].kind, len(errors)), None
+        end = compiled.steps[-1].joints
+        return Feasibility(True), None if end is None else np.array(end, dtype=np.float64)
+
+    def place(self, joints: FloatArray) -> None:
+        """Put the simulated robot at ``joints`` (rad) without recording a move (RoboDK's
+        ``setJoints`` and the end of a successful move test)."""
+        self._simulation("setJoints").place(joints)
 
     def _tcp_in_frame(self, joints: FloatArray) -> FloatArray:
         robot = self._station("Pose").robot
@@ -985,6 +1099,11 @@ class _Simulation:
         self.instructions = instructions
         self.done = 0
         self.q: FloatArray = np.array(station.robot.home, dtype=np.float64)
+
+    def place(self, joints: FloatArray) -> None:
+        """The robot is at ``joints`` now, after the instructions recorded so far."""
+        self.q = np.array(joints, dtype=np.float64)
+        self.done = len(self.instructions)
 
     def joints(self) -> FloatArray:
         moves = [i for i in self.instructions[self.done :] if ir.is_motion(i)]

@@ -28,10 +28,108 @@ from typing import TYPE_CHECKING, Any, Literal, TypeAlias, TypeGuard
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from olp import ir_flow as _flow
+from olp.ir_flow import (
+    BLOCK_TYPES as BLOCK_TYPES,
+)
+from olp.ir_flow import (
+    FLOW_TYPES as FLOW_TYPES,
+)
+
+# The statements beyond motion and I/O (control flow, data, kept source lines) live in
+# olp.ir_flow and are re-exported here, so that users import every IR node from olp.ir.
+from olp.ir_flow import (
+    Aggregate as Aggregate,
+)
+from olp.ir_flow import (
+    Assign as Assign,
+)
+from olp.ir_flow import (
+    BinaryOp as BinaryOp,
+)
+from olp.ir_flow import (
+    Block as Block,
+)
+from olp.ir_flow import (
+    Branch as Branch,
+)
+from olp.ir_flow import (
+    Case as Case,
+)
+from olp.ir_flow import (
+    Constant as Constant,
+)
+from olp.ir_flow import (
+    Declare as Declare,
+)
+from olp.ir_flow import (
+    DigitalInput as DigitalInput,
+)
+from olp.ir_flow import (
+    Exit as Exit,
+)
+from olp.ir_flow import (
+    Expr as Expr,
+)
+from olp.ir_flow import (
+    FlowError as FlowError,
+)
+from olp.ir_flow import (
+    For as For,
+)
+from olp.ir_flow import (
+    FunctionCall as FunctionCall,
+)
+from olp.ir_flow import (
+    Goto as Goto,
+)
+from olp.ir_flow import (
+    If as If,
+)
+from olp.ir_flow import (
+    Index as Index,
+)
+from olp.ir_flow import (
+    Label as Label,
+)
+from olp.ir_flow import (
+    Loop as Loop,
+)
+from olp.ir_flow import (
+    Member as Member,
+)
+from olp.ir_flow import (
+    Name as Name,
+)
+from olp.ir_flow import (
+    Repeat as Repeat,
+)
+from olp.ir_flow import (
+    Return as Return,
+)
+from olp.ir_flow import (
+    Statement as Statement,
+)
+from olp.ir_flow import (
+    Switch as Switch,
+)
+from olp.ir_flow import (
+    UnaryOp as UnaryOp,
+)
+from olp.ir_flow import (
+    Verbatim as Verbatim,
+)
+from olp.ir_flow import (
+    WaitUntil as WaitUntil,
+)
+from olp.ir_flow import (
+    While as While,
+)
 from olp.span import GENERATED, SourceSpan
 
 if TYPE_CHECKING:
     from typing import Self
+
 
 FloatArray: TypeAlias = NDArray[np.float64]
 IntArray: TypeAlias = NDArray[np.int64]
@@ -443,8 +541,19 @@ class Comment:
 
 Motion: TypeAlias = JointMove | LinearMove | CircularMove
 Instruction: TypeAlias = (
-    JointMove | LinearMove | CircularMove | Wait | SetOutput | WaitInput | Call | Comment
+    JointMove
+    | LinearMove
+    | CircularMove
+    | Wait
+    | SetOutput
+    | WaitInput
+    | Call
+    | Comment
+    | Statement
 )
+"""What iterating a program yields: motions, I/O, waits, calls, comments and the statements of
+:mod:`olp.ir_flow` (declarations, assignments, waits on conditions, labels and jumps, kept
+source lines), in source order; blocks are walked into, never yielded."""
 
 MOTION_TYPES = (JointMove, LinearMove, CircularMove)
 
@@ -604,8 +713,10 @@ def _check_rigid_rows(poses: FloatArray, what: str) -> None:
         raise IRError(f"{what} row {k}: not a rigid transform")
 
 
-Node: TypeAlias = Instruction | LinearPath
-"""What a program holds: an instruction, or a dense run of linear moves."""
+Node: TypeAlias = Instruction | LinearPath | Block
+"""What a program holds: an instruction, a dense run of linear moves, or a block of control
+flow (:class:`If`, :class:`Switch`, :class:`While`, :class:`Repeat`, :class:`Loop`,
+:class:`For`) holding more nodes."""
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -627,14 +738,25 @@ class Program:
             object.__setattr__(self, "instructions", tuple(self.instructions))
 
     def __iter__(self) -> Iterator[Instruction]:
-        for node in self.instructions:
+        for node in _flow.leaves(self.instructions):
             if isinstance(node, LinearPath):
                 yield from node
             else:
                 yield node
 
     def __len__(self) -> int:
-        return sum(len(n) if isinstance(n, LinearPath) else 1 for n in self.instructions)
+        nodes = _flow.leaves(self.instructions)
+        return sum(len(n) if isinstance(n, LinearPath) else 1 for n in nodes)
+
+    @property
+    def has_flow(self) -> bool:
+        """Whether the program holds control flow or data statements (:mod:`olp.ir_flow`)."""
+        return _flow.has_flow(self.instructions)
+
+    def flat_nodes(self) -> tuple[Instruction | LinearPath, ...]:
+        """The nodes in source order with blocks walked into: what the passes check, one step
+        per instruction (a toolpath stays one node)."""
+        return tuple(_flow.leaves(self.instructions))
 
     @property
     def dense(self) -> bool:
@@ -656,11 +778,14 @@ class Program:
         """A copy where every instruction is replaced by ``edit(instruction)``: an instruction,
         a sequence of them (inserted in its place), or None (deleted). A toolpath's rows are
         instructions like any other (the copy holds them as ordinary moves; for a dense edit of
-        a toolpath use :meth:`LinearPath.with_speeds` and friends)."""
-        out: list[Node] = []
-        for instruction in self:
-            out.extend(_as_list(edit(instruction)))
-        return self.replace_instructions(out)
+        a toolpath use :meth:`LinearPath.with_speeds` and friends). Blocks of control flow are
+        kept, with the instructions inside them edited the same way."""
+
+        def one(node: Any) -> list[Any]:
+            rows = list(node) if isinstance(node, LinearPath) else [node]
+            return [new for row in rows for new in _as_list(edit(row))]
+
+        return self.replace_instructions(_flow.map_leaves(self.instructions, one))
 
     def map_motions(self, edit: Callable[[Motion], Edit]) -> Program:
         """:meth:`map` on the motions only; other instructions are kept as they are::

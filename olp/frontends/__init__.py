@@ -26,7 +26,7 @@ from olp.errors import UsageError
 if TYPE_CHECKING:
     from importlib.metadata import EntryPoint
 
-    from olp.diagnostics import Diagnostic
+    from olp.diagnostics import Diagnostic, Severity
     from olp.ir import Program, SourceSpan
     from olp.station.model import Station
 
@@ -169,11 +169,16 @@ class _Ignored(Protocol):
     def reason(self) -> str: ...
 
 
-def ignored_notes(ignored: Sequence[_Ignored]) -> tuple[Diagnostic, ...]:
-    """Info diagnostics for what a frontend read but did not lower."""
+def ignored_notes(
+    ignored: Sequence[_Ignored],
+    severity: Severity = "info",
+    prefix: str = "line not lowered",
+) -> tuple[Diagnostic, ...]:
+    """Diagnostics for what a frontend read but did not lower: ``"warning"`` where the
+    statement is then missing from the output (nothing is dropped silently), ``"info"`` for
+    what never belonged in it (a data list's type definitions)."""
     from olp.diagnostics import Diagnostic
 
     return tuple(
-        Diagnostic("info", "ignored", f"line not lowered: {item.reason}", item.span)
-        for item in ignored
+        Diagnostic(severity, "ignored", f"{prefix}: {item.reason}", item.span) for item in ignored
     )

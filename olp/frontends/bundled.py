@@ -54,12 +54,22 @@ class KrlFrontend:
     def load(self, path: Path, options: KrlOptions, station: Station | None) -> ParsedProgram:
         from olp.diagnostics import Diagnostic
         from olp.frontends.krl import load_krl
+        from olp.ir import Verbatim
 
         result = load_krl(path, config_dat=options.config_dat)
         remarks = tuple(
             Diagnostic("warning", "krl_note", note.message, note.span) for note in result.notes
         )
-        return ParsedProgram(result.program, ignored_notes(result.ignored) + remarks)
+        src = os.fspath(path)
+        dropped = [i for i in result.ignored if i.span.file == src]
+        data = [i for i in result.ignored if i.span.file != src]
+        kept = tuple(
+            Diagnostic("info", "verbatim", f"kept as written (not modelled: {i.reason})", i.span)
+            for i in result.program
+            if isinstance(i, Verbatim)
+        )
+        notes = ignored_notes(dropped, "warning", "statement not in the output")
+        return ParsedProgram(result.program, notes + kept + remarks + ignored_notes(data))
 
 
 # ------------------------------------------------------------------------------------------------

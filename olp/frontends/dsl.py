@@ -9,14 +9,20 @@ calling process, for the child and for callers who already trust the text. Each 
 ``robot`` records one IR instruction whose span is the user's call (file, line and column of
 the innermost frame in the program file), so every later diagnostic points at the user's line.
 
+While the program runs, RoboDK's module names (``robolink``, ``robodk``, ``robodk.robolink``,
+``robodk.robomath`` ...) import olp's answers to them (:mod:`olp.compat`), so a RoboDK script
+runs unchanged; after the run they are gone. A script that fills RoboDK program items builds
+that program (:meth:`Session.built`).
+
 Parameters come from the command line (``--set SPEED=50``) and are read with
 ``param("SPEED", default)``: text is converted to the type of the default (bool, int, float or
 text; without a default an int, else a float, else the text). A ``--set`` name the program
 never asks for is a :class:`~olp.errors.UsageError` (a typo must not pass silently).
 
-Errors: a syntax error or a wrong DSL call is a :class:`~olp.errors.ParseError`, any other
-exception raised by the program a :class:`~olp.frontends.dsl_process.ProgramRunError` (a
-ParseError printed as "error running the program"), each at the user's line (the innermost
+Errors: a syntax error is a :class:`~olp.errors.ParseError`; a wrong DSL call (or RoboDK call,
+:mod:`olp.compat`) and any other exception raised by the program a
+:class:`~olp.frontends.dsl_process.ProgramRunError` (a ParseError printed as "error running
+the program", with the exception's own type and message), each at the user's line (the innermost
 traceback frame in the program file) with the line's text and a caret under the failing
 expression, never a traceback dump; when the exception passed through several of the user's
 own frames, the hint lists them (olp's and libraries' frames left out). ``sys.exit()`` /
@@ -63,6 +69,16 @@ class ProgramWarning:
 
     span: ir.SourceSpan
     message: str
+
+
+@dataclass(slots=True)
+class ProgramRecord:
+    """A program item the script made (RoboDK's ``AddProgram``): its instructions, and
+    whether ``MakeProgram`` asked for it."""
+
+    name: str
+    instructions: list[ir.Instruction]
+    made: bool = False
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -120,7 +136,9 @@ def run_dsl(
     text = _decode(source, filename)
     code = _compile(text, filename)
     session = Session(filename, text, station, params)
-    with dsl.active(session):
+    from olp.compat import importable
+
+    with dsl.active(session), importable():
         _execute(code, session, catch_interrupts)
     unused = session.unused_params()
     if unused:
@@ -129,7 +147,12 @@ def run_dsl(
             f"--set {dsl.names_list(unused)}: the program has no such parameter "
             f"(it reads: {declared})"
         )
-    if not session.instructions:
+    return _result(session, filename)
+
+
+def _result(session: Session, filename: str) -> DslResult:
+    """What the run recorded; the checks that need the finished run."""
+    if not session.recorded():
         raise ProgramRunError(
             "the program recorded no robot instructions (no move, I/O, wait, call or comment)",
             ir.SourceSpan(filename, 1, 1),
@@ -137,7 +160,10 @@ def run_dsl(
             "a program that ends early (sys.exit) or skips every move would write an empty "
             "robot program",
         )
-    return session.result()
+    try:
+        return session.result()
+    except dsl.DslError as exc:
+        raise ParseError(str(exc), ir.SourceSpan(filename, 1, 1), session.line_text(1)) from None
 
 
 # ------------------------------------------------------------------------------------------------
@@ -231,10 +257,9 @@ def _located(exc: BaseException, session: Session, message: str) -> ParseError:
         span = session.position(frame.tb_frame.f_code, frame.tb_lasti, frame.tb_lineno)
     trace = _user_trace(exc.__traceback__, session)
     hint = f"the program's traceback (most recent call last):{trace}" if trace else None
-    # A wrong DSL call is the frontend refusing a statement (a parse error, as in KRL); any
-    # other exception is the program's own failure.
-    kind = ParseError if isinstance(exc, dsl.DslError) else ProgramRunError
-    return kind(message, span, session.line_text(span.line), hint)
+    # The program was read; whatever stops it now (a wrong robot call or its own exception)
+    # is an error running it, never a "parse error".
+    return ProgramRunError(message, span, session.line_text(span.line), hint)
 
 
 def _user_trace(tb: TracebackType | None, session: Session) -> str:
@@ -307,6 +332,10 @@ class Session:
         self.ignored: list[IgnoredLine] = []
         self.warnings: list[ProgramWarning] = []
         self.targets: dict[str, dsl.Target] = {}
+        self.programs: list[ProgramRecord] = []
+        self.compat: Any = None
+        self._tool_numbers: dict[str, int] = {}
+        self._noted: set[tuple[ir.SourceSpan, str]] = set()
         self.robot = dsl.Robot(self)
         self._positions: dict[CodeType, list[tuple[Any, ...]]] = {}
 
@@ -322,10 +351,61 @@ class Session:
             **names,
         }
 
+    def tool_number(self, name: str) -> int:
+        """The controller number of a tool the program defines: the same for the same name,
+        else the next one above every station tool's and every earlier program tool's (posts
+        that address tools by number, Fanuc's ``UTOOL_NUM``, need one)."""
+        if name not in self._tool_numbers:
+            station_numbers = (
+                [t.number or 0 for t in self.station.tools.values()] if self.station else []
+            )
+            used = [0, *station_numbers, *self._tool_numbers.values()]
+            self._tool_numbers[name] = max(used) + 1
+        return self._tool_numbers[name]
+
+    def recorded(self) -> bool:
+        """Whether the run recorded any instruction (on the robot or in a program item)."""
+        return bool(self.instructions) or any(p.instructions for p in self.programs)
+
+    def built(self) -> tuple[str, list[ir.Instruction]]:
+        """The program olp builds: the robot's own recording, or, when the script filled
+        program items (RoboDK's ``AddProgram``), that program; the robot's moves were then its
+        simulation (noted). Several filled programs need ``MakeProgram`` on one of them."""
+        filled = [p for p in self.programs if p.instructions]
+        if not filled:
+            return self.name, self.instructions
+        made = [p for p in filled if p.made]
+        chosen = made[-1] if made else filled[0] if len(filled) == 1 else None
+        if chosen is None:
+            names = dsl.names_list([p.name for p in filled])
+            raise dsl.DslError(
+                f"the script filled {len(filled)} programs ({names}); olp builds one program "
+                "per run: call MakeProgram() on the one to build"
+            )
+        if self.instructions:
+            first = next((i.span for i in self.instructions if i.span is not None), None)
+            if first is not None:
+                reason = (
+                    f"the robot's own moves were simulated only; olp builds program "
+                    f"{dsl.quote(chosen.name)}"
+                )
+                text = (self.line_text(first.line) or "").strip()
+                self.ignored.append(IgnoredLine(first, text, reason))
+        return chosen.name, chosen.instructions
+
+    def note(self, reason: str) -> None:
+        """A call olp honours only partly or not at all (a GUI pop-up, a live connection):
+        noted once per line in the build output."""
+        span = self.span()
+        if (span, reason) not in self._noted:
+            self._noted.add((span, reason))
+            self.ignored.append(
+                IgnoredLine(span, (self.line_text(span.line) or "").strip(), reason)
+            )
+
     def result(self) -> DslResult:
-        program = ir.Program(
-            name=self.name, instructions=tuple(self.instructions), source=self.filename
-        )
+        name, instructions = self.built()
+        program = ir.Program(name=name, instructions=tuple(instructions), source=self.filename)
         return DslResult(
             program=program,
             ignored=tuple(self.ignored),

@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import enum
 import os
 import pickle
 import re
@@ -323,10 +324,45 @@ def _decode(path: Path, program: _Program) -> DslResult:
     if isinstance(payload, tuple) and len(payload) == 2:
         kind, value = payload
         if kind == "ok" and isinstance(value, DslResult) and isinstance(value.program, ir.Program):
-            return value
+            return _rebuilt_result(value, program)
         if kind == "error" and isinstance(value, dict):
             raise _error_from(value, program)
     raise program.error("the program's process sent back something that is not a result")
+
+
+def _rebuilt_result(result: DslResult, program: _Program) -> DslResult:
+    """``result`` made again through the constructors of its data classes.
+
+    Unpickling sets an object's fields without running its checks (``__post_init__``), and the
+    child ran the user's code, which can forge an instruction no constructor would make (a
+    one-line statement holding a line break, a negative wait). Rebuilding runs every check, so
+    what the passes and posts receive keeps the IR's invariants; a forged object is an error
+    on the program."""
+    try:
+        rebuilt: DslResult = _rebuilt(result)
+    except (ValueError, TypeError) as exc:
+        raise program.error(
+            f"the program's result holds an instruction olp's IR does not allow: "
+            f"{_short(str(exc))}",
+            hint="build the program with the robot's methods, not by setting object fields",
+        ) from None
+    return rebuilt
+
+
+def _rebuilt(value: Any) -> Any:
+    """``value`` with every data class made again by its constructor (recursively)."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        fields = {
+            f.name: _rebuilt(getattr(value, f.name)) for f in dataclasses.fields(value) if f.init
+        }
+        return type(value)(**fields)
+    if isinstance(value, tuple):
+        return tuple(_rebuilt(item) for item in value)
+    if isinstance(value, list):
+        return [_rebuilt(item) for item in value]
+    if isinstance(value, dict):
+        return {key: _rebuilt(item) for key, item in value.items()}
+    return value
 
 
 def _error_from(data: dict[str, Any], program: _Program) -> OlpError:
@@ -365,14 +401,18 @@ def _plain(module: str, name: str) -> bool:
 
 
 class _Unpickler(pickle.Unpickler):
-    """Builds only olp's data classes (the IR, the result), numpy arrays and plain data: the
-    result file is written by a process that ran the user's code, so nothing else (no function
-    call, no other class) may come out of it."""
+    """Builds only olp's data classes and enumerations (the IR, e.g. a circular move's
+    :class:`~olp.ir.ArcOrientation`, the result), numpy arrays and plain data: the result file
+    is written by a process that ran the user's code, so nothing else (no function call, no
+    other class) may come out of it. An enumeration is looked up by value, which runs nothing."""
 
     def find_class(self, module: str, name: str) -> Any:
         if module == "olp" or module.startswith("olp."):
             found = super().find_class(module, name)
-            if isinstance(found, type) and dataclasses.is_dataclass(found):
+            olp_type = isinstance(found, type) and (
+                dataclasses.is_dataclass(found) or issubclass(found, enum.Enum)
+            )
+            if olp_type:
                 return found
         elif (module, name) in _NUMPY or _plain(module, name):
             return super().find_class(module, name)

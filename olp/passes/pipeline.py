@@ -22,6 +22,7 @@ from olp import progress
 from olp.compiled import CompiledProgram
 from olp.ir import Program
 from olp.passes.collide import CollisionOptions, collision_pass
+from olp.passes.flow import flow_pass, flow_timing_note
 from olp.passes.resolve import ResolveOptions, resolve_pass
 from olp.passes.timing import TimingOptions, timing_pass
 from olp.station.model import Station
@@ -46,10 +47,16 @@ class BuildOptions:
 Pass = Callable[[CompiledProgram, BuildOptions], CompiledProgram]
 """A pass: a compiled program and the build options in, a compiled program out."""
 
-PIPELINE: tuple[Pass, ...] = (resolve_pass, collision_pass, timing_pass)
+PIPELINE: tuple[Pass, ...] = (
+    resolve_pass,
+    flow_pass,
+    collision_pass,
+    timing_pass,
+    flow_timing_note,
+)
 """What a build runs."""
 
-CHECKS: tuple[Pass, ...] = (resolve_pass, collision_pass)
+CHECKS: tuple[Pass, ...] = (resolve_pass, flow_pass, collision_pass)
 """What ``olp check`` runs: every check, no timing."""
 
 

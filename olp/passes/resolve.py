@@ -108,7 +108,7 @@ def resolve(
     state = _State(q=robot.home.copy(), robot=robot, opts=opts)
     items: list[Item] = []
     diags: list[Diagnostic] = []
-    nodes = program.instructions
+    nodes = program.flat_nodes()  # control flow: each instruction once, in source order
     index = flat = 0
     while index < len(nodes):
         node = nodes[index]
@@ -136,7 +136,7 @@ def resolve(
         index, flat = index + 1, flat + 1
         progress.advance(1)
     steps = make_steps(items)
-    if isinstance(steps, StepBlocks):
+    if isinstance(steps, StepBlocks) and not program.has_flow:
         program = program.replace_instructions([_node_of(item) for item in steps.blocks])
     return CompiledProgram(
         program=program,

@@ -62,12 +62,14 @@ from olp.diagnostics import Diagnostic
 from olp.errors import PostError
 from olp.posts.base import Filter, Post
 from olp.posts.numbers import NumberFormat, Storage
+from olp.posts.sandbox import SafeText
 from olp.posts.text import IDENTIFIER, NUMBER, ArgumentRule, NameRule, one_of
 from olp.vendors.abb import confdata, normalised_rounded, pose_to_robtarget
 
 if TYPE_CHECKING:
     from olp.compiled import CompiledProgram, Step
-    from olp.posts.view import PostFrame, PostStep, PostTool
+    from olp.posts.rows import PostRows
+    from olp.posts.view import Modal, PostFrame, PostStep, PostTool
 
 QUATERNION_DECIMALS = 9
 """Quaternion components, as RobotStudio writes them; a 1e-9 component error is ~2e-9 rad."""
@@ -234,6 +236,60 @@ def rapid_signal(post: Post, index: int, pattern: str) -> str:
     return name
 
 
+def rapid_rows_data(post: Post, rows: PostRows) -> SafeText:
+    """The robtarget declarations of a run of MoveL (:mod:`olp.posts.rows`), exactly as
+    ``module.mod.j2`` writes each (``LOCAL CONST robtarget p12 := [..];``): positions and
+    quaternions formatted as columns. Names are legal identifiers and numbers are checked, so
+    the lines are :class:`~olp.posts.sandbox.SafeText`."""
+    steps = rows.steps
+    trans, rot = pose_to_robtarget(rows.poses())
+    xyz = post.number_column("position", trans, steps)
+    quat = post.number_column("quaternion", normalised_rounded(rot, QUATERNION_DECIMALS), steps)
+    extax = ",".join([EXTERNAL_AXIS_UNUSED] * 6)
+    lines = []
+    for k, step in enumerate(steps):
+        p, q = 3 * k, 4 * k
+        pose = f"[{xyz[p]},{xyz[p + 1]},{xyz[p + 2]}],[{','.join(quat[q : q + 4])}]"
+        conf = rapid_confdata(step.vendor["confdata"])
+        lines.append(f"  LOCAL CONST robtarget {step.name} := [{pose},{conf},[{extax}]];")
+    return SafeText("\n".join(lines))
+
+
+def rapid_rows(post: Post, rows: PostRows, modal: Modal | None = None) -> SafeText:
+    """The moves of a run of MoveL (:mod:`olp.posts.rows`), exactly as ``module.mod.j2``
+    writes each: ``PathAccLim`` where the path acceleration changes (``modal``, the template's
+    state; without it, where a set one changes within the run), then
+    ``MoveL p12, v100, z10, tool\\WObj:=wobj;`` (speed and zone data names computed once per
+    distinct value)."""
+    names: dict[Any, str] = {}
+    lines = []
+    previous = None
+    for step in rows.steps:
+        post.current_step = step
+        accel = step.speed.linear_acceleration
+        if modal.changed("path_acc", accel) if modal is not None else accel not in (None, previous):
+            lines.append(path_acc_line(post, accel))
+        previous = accel
+        speed = names.get(step.speed)
+        if speed is None:
+            speed = names[step.speed] = speed_name(post, step.speed)
+        zone = names.get(step.zone)
+        if zone is None:
+            zone = names[step.zone] = zone_name(post, step.zone)
+        wobj = "" if step.frame_name == "wobj0" else "\\WObj:=" + step.frame_name
+        lines.append(f"    MoveL {step.name}, {speed}, {zone}, {step.tool_name}{wobj};")
+    post.current_step = rows
+    return SafeText("\n".join(lines))
+
+
+def path_acc_line(post: Post, accel: float | None) -> str:
+    """``PathAccLim`` for a path acceleration ``accel`` m/s² (None: the controller's own)."""
+    if accel is None:
+        return "    PathAccLim FALSE, FALSE;"
+    value = post.number("path_acc", accel)
+    return f"    PathAccLim TRUE \\AccMax:={value}, TRUE \\DecelMax:={value};"
+
+
 def _robtarget_filter(post: Post, joints: ArrayLike, robot: Any, pose: ArrayLike) -> str:
     """Template filter: ``joints | rapid_robtarget(robot, pose)``."""
     return rapid_robtarget(post, pose, confdata(robot, joints))
@@ -254,8 +310,11 @@ FILTERS: Mapping[str, Filter] = {
     "rapid_tooldata": rapid_tooldata,
     "rapid_wobjdata": rapid_wobjdata,
     "rapid_speed": speed_name,
+    "rapid_path_acc": path_acc_line,
     "rapid_zone": zone_name,
     "rapid_signal": rapid_signal,
+    "rapid_rows_data": rapid_rows_data,
+    "rapid_rows": rapid_rows,
 }
 
 
@@ -265,6 +324,7 @@ class AbbPost(Post):
     NAME = "abb"
     VENDOR = "abb"
     LANGUAGE = "RAPID"
+    ROWS = True
     NAME_RULE = NAME_RULE
     CALL_ARGUMENTS = ArgumentRule(
         one_of(NUMBER, r'"[^"\\\x00-\x1f\x7f-\x9f\u2028\u2029]{0,80}"', IDENTIFIER),

@@ -27,7 +27,11 @@ What every post checks (:meth:`Post.check`), so that no brand can forget it:
   (``CALL_ARGUMENTS``): ``Grip(1;MoveAbsJ ...)`` can never write a live move (``call_name``,
   ``call_argument``);
 * digital I/O numbers within the controller's range (``IO_RANGE``, ``io_range``);
-* a station robot of another brand than the post's (a warning, ``foreign_robot``).
+* a station robot of another brand than the post's (a warning, ``foreign_robot``);
+* a :class:`~olp.ir.Verbatim` statement of another language than the post's ``VERBATIM`` is an
+  error naming its line (``verbatim``); with the template folder's option
+  ``foreign_verbatim: drop`` it is left out with a warning showing its text
+  (``verbatim_dropped``).
 
 Numbers are written through :meth:`Post.number` with a quantity of ``NUMBERS``
 (:mod:`olp.posts.numbers`): a value the controller cannot hold as checked and timed is an error on
@@ -62,6 +66,7 @@ from olp.posts.text import (
 if TYPE_CHECKING:
     from olp.compiled import CompiledProgram, Step
     from olp.posts.manifest import PostManifest
+    from olp.posts.rows import PostRows
     from olp.posts.view import PostStep
 
 FloatArray = NDArray[np.float64]
@@ -74,9 +79,20 @@ Transform = Callable[["CompiledProgram", "Post"], "tuple[CompiledProgram, list[D
 """An IR rewrite a language needs before rendering, with the diagnostics it gives."""
 
 ALL_KINDS = frozenset(
-    {"joint", "linear", "circular", "wait", "set_output", "wait_input", "call", "comment"}
+    {
+        "joint",
+        "linear",
+        "circular",
+        "wait",
+        "set_output",
+        "wait_input",
+        "call",
+        "comment",
+        "verbatim",
+    }
+    | {"declare", "assign", "wait_until", "label", "goto", "exit", "return"}
 )
-"""Instruction kinds of the IR."""
+"""Instruction kinds of the IR (a program's blocks are not instructions: see ``WRITES_FLOW``)."""
 
 GENERIC_NUMBER = NumberFormat("number", "", 3)
 """The ``num`` filter's format where a template names no quantity (range: any finite value)."""
@@ -119,6 +135,13 @@ class Post:
     """Digital output and input numbers the controller has (None: no numbers are written)."""
     KINDS: ClassVar[frozenset[str]] = ALL_KINDS
     """Instruction kinds the templates write."""
+    WRITES_FLOW: ClassVar[bool] = False
+    """Whether the templates write control flow and data statements (:mod:`olp.ir_flow`); a
+    post that does not stops on a program holding them, naming the first one, rather than
+    writing its instructions in a row."""
+    VERBATIM: ClassVar[str | None] = None
+    """The language of :class:`~olp.ir.Verbatim` statements this post writes unchanged (KUKA:
+    ``"krl"``); a verbatim statement of another language is an error on its line."""
     NUMBERS: ClassVar[Mapping[str, NumberFormat]] = {"number": GENERIC_NUMBER}
     FILTERS: ClassVar[Mapping[str, Filter]] = {
         "num": _num,
@@ -144,10 +167,13 @@ class Post:
     (``"linear_acceleration"``, ``"angular_acceleration"``); one it cannot is a warning on the
     first move that sets it (the robot then runs with the controller's own value, and the
     cycle time differs from the estimate)."""
+    ROWS: ClassVar[bool] = False
+    """Whether the post writes runs of linear moves with a row writer (:mod:`olp.posts.rows`);
+    used only where the template folder says ``rows: true`` and :meth:`rows_enabled` agrees."""
 
     def __init__(self, manifest: PostManifest) -> None:
         self.manifest = manifest
-        self.current_step: PostStep | None = None
+        self.current_step: PostStep | PostRows | None = None
         self.problems: list[Diagnostic] = []
         self.collecting = False
         """While rendering: numbers that cannot be written are collected as diagnostics on the
@@ -195,6 +221,8 @@ class Post:
     def check(self, compiled: CompiledProgram) -> list[Diagnostic]:
         """Everything this post reports about ``compiled``; errors mean nothing is written."""
         out = self._foreign_robot(compiled)
+        if compiled.program.has_flow and not self.WRITES_FLOW:
+            return [*out, self._flow_error(compiled)]
         compiled = compiled.flat()
         for step in compiled.steps:
             out += self._shared_checks(step)
@@ -224,14 +252,19 @@ class Post:
                 out.append(_warning("acceleration", msg, moves[0]))
         return out
 
-    def render(self, compiled: CompiledProgram, name: str | None = None) -> dict[str, str]:
+    def render(
+        self, compiled: CompiledProgram, name: str | None = None, *, prepared: bool = False
+    ) -> dict[str, str]:
         """Every file of the program (:func:`olp.posts.render.render`), after the
         ``TRANSFORMS`` (which are idempotent: a program :meth:`prepare` already rewrote stays as
-        it is), so the text never depends on whether the caller prepared the program."""
+        it is), so the text never depends on whether the caller prepared the program.
+        ``prepared``: the caller has just applied :meth:`prepare` (skip doing it again)."""
         from olp.posts.render import render
 
+        if not prepared:
+            compiled = self.prepare(compiled)[0]
         # The templates walk the steps row by row several times: make a toolpath's rows once.
-        return render(self.prepare(compiled)[0].flat(), self, name)
+        return render(compiled.flat(), self, name)
 
     def write(self, files: Mapping[str, str], folder: Path) -> list[Path]:
         """Encode every file in the manifest's encoding (a character it lacks is a PostError
@@ -267,6 +300,36 @@ class Post:
         """``value`` in the printed unit of ``quantity`` (``NUMBERS``), checked; a value that
         cannot be written becomes an error on the instruction being written."""
         return self.number_with(self.NUMBERS[quantity], value)
+
+    def number_column(self, quantity: str, values: Any, steps: Sequence[PostStep]) -> list[str]:
+        """:meth:`number` for values (n, k) or (n,), row r belonging to ``steps[r]``: spelled and
+        checked as one column (:func:`~olp.posts.numbers.format_numbers`); a value that cannot
+        be written is an error on its own row's instruction. Row-major, n * k texts."""
+        v = np.asarray(values, dtype=np.float64)
+        fmt = self.NUMBERS[quantity]
+        try:
+            return format_numbers(v, fmt)
+        except NumberError:
+            pass
+        saved, out = self.current_step, []
+        per_row = v.reshape(len(steps), -1)
+        for step, row in zip(steps, per_row, strict=True):
+            self.current_step = step
+            out += [self.number_with(fmt, float(x)) for x in row]
+        self.current_step = saved
+        return out
+
+    def rows_enabled(self) -> bool:
+        """Whether runs of linear moves go to the row writer: the post has one, the template
+        folder declares ``rows: true``, and (per brand) the options allow it."""
+        return self.ROWS and self.manifest.rows
+
+    def group(self, steps: Sequence[PostStep]) -> list[PostStep | PostRows]:
+        """A file's steps as its templates see them (:func:`olp.posts.rows.group_rows` where
+        :meth:`rows_enabled`)."""
+        from olp.posts.rows import group_rows
+
+        return group_rows(steps) if self.rows_enabled() else list(steps)
 
     def numbers(self, quantity: str, values: Any) -> list[str]:
         """:meth:`number` for an array of values (N,)."""
@@ -320,6 +383,8 @@ class Post:
     def _shared_checks(self, step: Step) -> list[Diagnostic]:
         ins: Any = step.instruction
         kind = ins.kind
+        if kind == "verbatim":
+            return self._verbatim_checks(step, ins)
         if kind not in self.KINDS:
             msg = f"the {self.LANGUAGE} post cannot write a {kind.replace('_', ' ')} instruction"
             return [_error("unsupported", msg, step)]
@@ -359,6 +424,40 @@ class Post:
         except ValueError as exc:
             return [_error("comment", f"comment holds a {exc}: it cannot be written", step)]
         return self._encoding_checks(step, "comment", "\n".join(lines))
+
+    def _flow_error(self, compiled: CompiledProgram) -> Diagnostic:
+        from olp.ir_flow import FLOW_TYPES, leaves_and_blocks
+
+        first = next(
+            n for n in leaves_and_blocks(compiled.program.instructions) if isinstance(n, FLOW_TYPES)
+        )
+        what = first.kind.replace("_", " ")
+        return Diagnostic(
+            "error",
+            "control_flow",
+            f"the {self.LANGUAGE} post does not write control flow and data statements yet "
+            f"(first: {what} at line {first.span.line}); nothing of the program is written",
+            first.span,
+        )
+
+    def _verbatim_checks(self, step: Step, ins: Any) -> list[Diagnostic]:
+        """A statement kept as source text goes out unchanged to its own language only; it was
+        checked to be one line when made, so it cannot start another statement."""
+        if ins.language == self.VERBATIM:
+            return self._encoding_checks(step, "verbatim", ins.text)
+        what = f"{ins.language.upper()} statement {_quote(ins.text)} (line {ins.span.line})"
+        if self.options.get("foreign_verbatim") == "drop":
+            msg = f"{what} is not written: the option foreign_verbatim: drop leaves it out"
+            return [Diagnostic("warning", "verbatim_dropped", msg, ins.span, step.index)]
+        msg = (
+            f"{what} is kept verbatim because olp does not model it ({ins.reason}); the "
+            f"{self.LANGUAGE} post cannot write it"
+        )
+        hint = (
+            "write it for this controller by hand, remove it from the source program, or leave "
+            "it out with a warning: the post option foreign_verbatim: drop (in a copy of the post)"
+        )
+        return [_error("verbatim", msg, step, hint=hint)]
 
     def _call_checks(self, step: Step, name: str, args: Sequence[str]) -> list[Diagnostic]:
         if not self.NAME_RULE.is_legal(name):

@@ -86,6 +86,7 @@ from olp.diagnostics import Diagnostic
 from olp.geometry import inv
 from olp.posts.base import Filter, Post
 from olp.posts.numbers import NumberError, NumberFormat, Storage
+from olp.posts.rows import PostRows
 from olp.posts.sandbox import SafeText
 from olp.posts.text import ArgumentRule, CommentRule, NameRule
 from olp.vendors.fanuc import (
@@ -97,7 +98,7 @@ from olp.vendors.fanuc import (
 )
 
 if TYPE_CHECKING:
-    from olp.compiled import CompiledProgram
+    from olp.compiled import CompiledProgram, Step
     from olp.posts.view import PostStep
 
 FloatArray = NDArray[np.float64]
@@ -230,19 +231,39 @@ class LsMove:
     via: LsPosition | None = None
     set_uf: bool = False
     set_ut: bool = False
+    rows: ClassVar[bool] = False
+
+
+@dataclass(frozen=True, slots=True)
+class LsRows:
+    """The LS motions of a run of linear moves (:mod:`olp.posts.rows`): one :class:`LsMove` per
+    row, written by :func:`ls_rows_mn` and :func:`ls_rows_pos`."""
+
+    rows_steps: PostRows
+    moves: tuple[LsMove, ...]
+    rows: ClassVar[bool] = True
 
 
 def ls_moves(
-    post: Post, steps: Sequence[PostStep], robot: Any, options: Mapping[str, Any] | None = None
-) -> dict[int, LsMove]:
+    post: Post,
+    steps: Sequence[PostStep | PostRows],
+    robot: Any,
+    options: Mapping[str, Any] | None = None,
+) -> dict[int, LsMove | LsRows]:
     """Template filter ``steps | ls_moves(robot, options)``: the LS motion of every motion of
     one file (template view steps, in order), by instruction index. Positions are numbered from
     1 in each file; ``UFRAME_NUM``/``UTOOL_NUM`` are set before the file's first motion and
     where they change."""
-    out: dict[int, LsMove] = {}
+    out: dict[int, LsMove | LsRows] = {}
     last: tuple[int, int] | None = None
     number = 0
     for step in steps:
+        if isinstance(step, PostRows):
+            moves = _row_moves(post, step, number, last, options)
+            out[step.index] = LsRows(step, moves)
+            number = moves[-1].target.number
+            last = (moves[-1].target.uf, moves[-1].target.ut)
+            continue
         if step.joints is None:
             continue
         post.current_step = step
@@ -259,6 +280,96 @@ def ls_moves(
         last = (uf, ut)
     post.current_step = None
     return out
+
+
+def _row_moves(
+    post: Post,
+    rows: PostRows,
+    number: int,
+    last: tuple[int, int] | None,
+    options: Mapping[str, Any] | None,
+) -> tuple[LsMove, ...]:
+    """:func:`ls_moves` of a run of linear moves, positions numbered from ``number + 1``: the
+    numbers of all Cartesian positions formatted as columns, the others (no CONFIG selects the
+    joints alone) as joints."""
+    steps = rows.steps
+    uf = [uframe_number(s.frame) for s in steps]
+    ut = [utool_number(s.tool, options) for s in steps]
+    configs = [s.vendor.get("config") if s.cartesian else None for s in steps]
+    cartesian = [k for k, c in enumerate(configs) if c is not None]
+    values: list[tuple[str, ...]] = [()] * len(steps)
+    if cartesian:
+        chosen = [steps[k] for k in cartesian]
+        poses = np.stack([s.pose for s in chosen])  # type: ignore[misc]
+        world = np.stack([s.frame_pose for s in chosen]) @ poses  # type: ignore[misc]
+        in_uf = np.where(np.array([uf[k] > 0 for k in cartesian])[:, None, None], poses, world)
+        v = pose_to_xyzwpr(in_uf)
+        xyz = post.number_column("position", v[:, :3], chosen)
+        wpr = post.number_column("angle", v[:, 3:], chosen)
+        for j, k in enumerate(cartesian):
+            values[k] = (*xyz[3 * j : 3 * j + 3], *wpr[3 * j : 3 * j + 3])
+    for k, step in enumerate(steps):
+        if configs[k] is None:
+            post.current_step = step
+            values[k] = tuple(ls_joints(post, step.joints))  # type: ignore[arg-type]
+    post.current_step = rows
+    out = []
+    for k in range(len(steps)):
+        number += 1
+        target = LsPosition(number, uf[k], ut[k], configs[k], values[k])
+        out.append(
+            LsMove(target, None, last is None or last[0] != uf[k], last is None or last[1] != ut[k])
+        )
+        last = (uf[k], ut[k])
+    return tuple(out)
+
+
+def ls_rows_mn(post: Post, moves: LsRows) -> SafeText:
+    """The ``/MN`` lines of a run of linear moves, exactly as ``program.ls.j2`` writes each:
+    ``UFRAME_NUM``/``UTOOL_NUM`` where they change, then ``L P[n] v mm/sec term``."""
+    speeds: dict[Any, str] = {}
+    terms: dict[Any, str] = {}
+    lines = []
+    for step, move in zip(moves.rows_steps.steps, moves.moves, strict=True):
+        post.current_step = step
+        if move.set_uf:
+            lines.append(f"  UFRAME_NUM={move.target.uf} ;")
+        if move.set_ut:
+            lines.append(f"  UTOOL_NUM={move.target.ut} ;")
+        speed = speeds.get(step.speed)
+        if speed is None:
+            speed = speeds[step.speed] = linear_mm_per_s(post, step.speed)
+        term = terms.get(step.zone)
+        if term is None:
+            term = terms[step.zone] = termination(post, step.zone)
+        lines.append(f"L P[{move.target.number}] {speed}mm/sec {term}    ;")
+    post.current_step = moves.rows_steps
+    return SafeText("\n".join(lines))
+
+
+def ls_rows_pos(post: Post, moves: LsRows) -> SafeText:
+    """The ``/POS`` entries of a run of linear moves, exactly as the template's ``position``
+    macro writes each (each entry ends with its line break)."""
+    return SafeText("".join(_position_text(move.target) for move in moves.moves))
+
+
+def _position_text(p: LsPosition) -> str:
+    v = p.values
+    if p.cartesian:
+        x, y, z, w, pp, r = (f"{value:>9}" for value in v)
+        body = (
+            f"\tUF : {p.uf}, UT : {p.ut},\t\tCONFIG : '{p.config}',\n"
+            f"\tX = {x}  mm,\tY = {y}  mm,\tZ = {z}  mm,\n"
+            f"\tW = {w} deg,\tP = {pp} deg,\tR = {r} deg\n"
+        )
+    else:
+        j = [f"{value:>10}" for value in v]
+        body = (
+            f"\tUF : {p.uf}, UT : {p.ut},\n"
+            f"\tJ1={j[0]} deg,\tJ2={j[1]} deg,\tJ3={j[2]} deg,\n"
+            f"\tJ4={j[3]} deg,\tJ5={j[4]} deg,\tJ6={j[5]} deg\n"
+        )
+    return f"P[{p.number}]{{\n   GP1:\n{body}}};\n"
 
 
 def _in_user_frame(step: PostStep, pose_in_frame: ArrayLike, uf: int) -> FloatArray:
@@ -343,6 +454,8 @@ FILTERS: Mapping[str, Filter] = {
     "ls_line_count": line_count,
     "ls_xyz_field": _xyz_filter,
     "ls_joint_field": _joint_filter,
+    "ls_rows_mn": ls_rows_mn,
+    "ls_rows_pos": ls_rows_pos,
 }
 
 
@@ -352,6 +465,7 @@ class FanucPost(Post):
     NAME = "fanuc"
     VENDOR = "fanuc"
     LANGUAGE = "LS"
+    ROWS = True
     NAME_RULE = NAME_RULE
     COMMENTS = CommentRule(max_length=COMMENT_LENGTH, replace=((";", ","),), collapse=True)
     IO_RANGE = (1, 4096)
@@ -359,10 +473,48 @@ class FanucPost(Post):
     NUMBERS: ClassVar[Mapping[str, NumberFormat]] = NUMBERS
     FILTERS: ClassVar[Mapping[str, Filter]] = FILTERS
 
+    def __init__(self, manifest: Any) -> None:
+        super().__init__(manifest)
+        self._configs: dict[int, tuple[Any, dict[bytes, str | None]]] = {}
+
+    def check_instruction(self, step: Step, compiled: CompiledProgram) -> list[Diagnostic]:
+        """``speed_raised`` (warning): a speed LS cannot write so slow, written at its least
+        (``L``/``C`` 1mm/sec, ``J`` 1%): the robot moves faster there than programmed and
+        timed."""
+        ins: Any = step.instruction
+        if step.skipped or ins.kind not in ("joint", "linear", "circular"):
+            return []
+        if ins.kind == "joint":
+            given, least, unit = ins.speed.joint * 100.0, 1, "%"
+        else:
+            given, least, unit = ins.speed.linear * 1000.0, 1, "mm/sec"
+        if _round_half_up(given) >= least:
+            return []
+        message = (
+            f"speed {given:.3g} {unit} is below the least LS can write; written as "
+            f"{least}{unit}, faster than programmed"
+        )
+        return [Diagnostic("warning", "speed_raised", message, ins.span, step.index)]
+
     def step_values(self, robot: Any, joints: Any) -> list[Mapping[str, Any]]:
         """Per planned motion (joints (N, 6) rad) ``{"config": str | None}``, the CONFIG a
         Cartesian position gets (:func:`olp.vendors.fanuc.selecting_configs`)."""
-        return [{"config": c} for c in selecting_configs(robot, joints)]
+        return [{"config": c} for c in self.selecting_configs(robot, joints)]
+
+    def selecting_configs(self, robot: Any, joints: Any) -> list[str | None]:
+        """:func:`olp.vendors.fanuc.selecting_configs`, remembered per joint vector for this
+        post and robot: the checks and the render ask for the same motions (an IK per row)."""
+        q = np.asarray(joints, dtype=np.float64).reshape(-1, 6)
+        memo = self._configs.get(id(robot))
+        if memo is None or memo[0] is not robot:
+            memo = self._configs[id(robot)] = (robot, {})
+        known = memo[1]
+        keys = [row.tobytes() for row in q]
+        missing = [k for k, key in enumerate(keys) if key not in known]
+        if missing:
+            found = selecting_configs(robot, q[missing])
+            known.update(zip((keys[k] for k in missing), found, strict=True))
+        return [known[key] for key in keys]
 
     def check_program(self, compiled: CompiledProgram) -> list[Diagnostic]:
         """Frame and tool numbers LS cannot write (errors), a tool number olp chose (warning,
@@ -373,7 +525,7 @@ class FanucPost(Post):
         motions = [s for s in compiled.steps if s.joints is not None]
         out = _frame_checks(self, motions, robot)
         out += _tool_checks(self, motions, self.options)
-        return out + _joint_position_notes(motions, robot)
+        return out + _joint_position_notes(self, motions, robot)
 
 
 def _first_use(motions: Sequence[Any], attr: str) -> dict[str, Any]:
@@ -427,14 +579,14 @@ def _tool_checks(
     return out
 
 
-def _joint_position_notes(motions: Sequence[Any], robot: Any) -> list[Diagnostic]:
+def _joint_position_notes(post: FanucPost, motions: Sequence[Any], robot: Any) -> list[Diagnostic]:
     """Info per Cartesian target written in joint form (no CONFIG selects it alone)."""
     cartesian = [s for s in motions if _is_cartesian(s.instruction)]
     if not cartesian:
         return []
     joints = np.stack([np.asarray(s.joints, dtype=np.float64) for s in cartesian])
     out: list[Diagnostic] = []
-    for step, config in zip(cartesian, selecting_configs(robot, joints), strict=True):
+    for step, config in zip(cartesian, post.selecting_configs(robot, joints), strict=True):
         if config is None:
             msg = (
                 "Cartesian target written as joint values: no CONFIG selects the planned "

@@ -57,14 +57,18 @@ from numpy.typing import ArrayLike
 from olp.diagnostics import Diagnostic
 from olp.errors import PostError
 from olp.ir import ArcOrientation, CartesianTarget
+from olp.ir_flow import FLOW_TYPES, leaves_and_blocks
 from olp.posts.base import Filter, Post
+from olp.posts.kuka_flow import flow_problem, krl_decl, krl_expr
 from olp.posts.numbers import NumberFormat, Storage
+from olp.posts.sandbox import SafeText
 from olp.posts.text import IDENTIFIER, NUMBER, ArgumentRule, NameRule, double_quoted, one_of
 from olp.vendors.kuka import ARC_TYPES, pose_to_frame, status_turn, turn_ambiguous
 
 if TYPE_CHECKING:
     from olp.compiled import CompiledProgram, Step
-    from olp.posts.view import PostStep
+    from olp.posts.rows import PostRows
+    from olp.posts.view import Modal, PostStep
 
 _KEYWORDS = """
 AND ANIN ANOUT B_AND B_EXOR B_NOT B_OR BOOL BRAKE C_DIS C_ORI C_PTP C_VEL CASE CHAR CIRC
@@ -217,6 +221,54 @@ def krl_ca(post: Post, step: PostStep) -> str:
     return "" if angle is None else f", CA {post.number('angle', math.degrees(angle))}"
 
 
+def krl_rows(post: Post, rows: PostRows, modal: Modal, arcs_written: bool = False) -> SafeText:
+    """The lines of a run of LINs (:mod:`olp.posts.rows`), exactly as ``program.src.j2`` writes
+    each (inline points): ``$BASE``/``$TOOL`` where they change, ``$VEL.CP`` (and ``$VEL.ORI``,
+    ``$ACC.CP``, ``$ACC.ORI1`` where set) where the speed changes, ``$APO.CDIS`` where the
+    approximation distance changes (``modal``),
+    ``$ORI_TYPE = #VAR`` after an arc (``arcs_written``), then ``LIN {E6POS} [C_DIS]``. The
+    targets' numbers are formatted as columns. Every piece is a checked number, a legal name or
+    a keyword, so the lines are :class:`~olp.posts.sandbox.SafeText`."""
+    steps = rows.steps
+    n = len(steps)
+    frames = pose_to_frame(rows.poses())
+    xyz = post.number_column("position", frames[:, :3], steps)
+    abc = post.number_column("angle", frames[:, 3:], steps)
+    mode = str(post.options.get("frames", "inline"))
+    lines: list[str] = []
+    for k, step in enumerate(steps):
+        post.current_step = step
+        if step.new_frame:
+            lines.append(f"$BASE = {krl_base(post, step, mode)} ; {step.frame_name}")
+        if step.new_tool:
+            lines.append(f"$TOOL = {krl_tool(post, step, mode)} ; {step.tool_name}")
+        speed, zone = step.speed, step.zone
+        if step.new_linear_speed:
+            lines.append(f"$VEL.CP = {post.number('vel_cp', speed.linear)}")
+            if speed.angular is not None:
+                ori = post.number("vel_ori", math.degrees(speed.angular))
+                lines += [f"$VEL.ORI1 = {ori}", f"$VEL.ORI2 = {ori}"]
+            if speed.linear_acceleration is not None:
+                lines.append(f"$ACC.CP = {post.number('acc_cp', speed.linear_acceleration)}")
+            if speed.angular_acceleration is not None:
+                acc_ori = post.number("acc_ori", math.degrees(speed.angular_acceleration))
+                lines.append(f"$ACC.ORI1 = {acc_ori}")
+        fine = zone.is_fine
+        if not fine and modal.changed("cdis", zone.radius):
+            lines.append(f"$APO.CDIS = {post.number('cdis', zone.radius * 1000)}")
+        if arcs_written and modal.changed("ori_type", "VAR"):
+            lines.append("$ORI_TYPE = #VAR")
+        p, o = 3 * k, 3 * k
+        target = (
+            f"X {xyz[p]},Y {xyz[p + 1]},Z {xyz[p + 2]},A {abc[o]},B {abc[o + 1]},C {abc[o + 2]}"
+            f",S {int(step.vendor['status'])},T {int(step.vendor['turn'])}"
+        )
+        lines.append(f"LIN {{{target}}}" + ("" if fine else " C_DIS"))
+    post.current_step = rows
+    assert len(xyz) == len(abc) == 3 * n
+    return SafeText("\n".join(lines))
+
+
 def _is_identity(pose: ArrayLike) -> bool:
     return bool(np.allclose(pose, np.eye(4), rtol=0.0, atol=1e-12))
 
@@ -245,6 +297,9 @@ FILTERS: Mapping[str, Filter] = {
     "krl_percent": krl_percent,
     "krl_arc_types": krl_arc_types,
     "krl_ca": krl_ca,
+    "krl_rows": krl_rows,
+    "krl_expr": lambda post, expr: krl_expr(expr),
+    "krl_decl": lambda post, step: krl_decl(step),
 }
 
 
@@ -254,6 +309,8 @@ class KukaPost(Post):
     NAME = "kuka"
     VENDOR = "kuka"
     LANGUAGE = "KRL"
+    VERBATIM = "krl"
+    WRITES_FLOW = True
     NAME_RULE = NAME_RULE
     IO_RANGE = (1, 4096)
     CALL_ARGUMENTS = ArgumentRule(
@@ -267,6 +324,12 @@ class KukaPost(Post):
     FILTERS: ClassVar[Mapping[str, Filter]] = FILTERS
     ARC_ORIENTATIONS = frozenset(ARC_TYPES) - {ArcOrientation.WRIST}
     ARC_ANGLE = True
+    ROWS = True
+
+    def rows_enabled(self) -> bool:
+        """Runs of LINs go to :func:`krl_rows` with inline points (named points also need their
+        declarations in the .dat, which its template writes per motion)."""
+        return super().rows_enabled() and self.options.get("points", "inline") == "inline"
 
     def step_values(self, robot: Any, joints: Any) -> list[Mapping[str, Any]]:
         """Status and Turn of each motion's planned joints (N, 6) rad, and whether Turn cannot
@@ -297,6 +360,16 @@ class KukaPost(Post):
         return _joint_checks(step.index, ins, self.options) + _ambiguity(
             compiled.station.robot, step
         )
+
+    def check_program(self, compiled: CompiledProgram) -> list[Diagnostic]:
+        """* ``flow`` (error): a name or text of a control-flow statement or condition that
+        KRL cannot hold (:func:`olp.posts.kuka_flow.flow_problem`)."""
+        found = []
+        for node in leaves_and_blocks(compiled.program.instructions):
+            if isinstance(node, FLOW_TYPES) and (problem := flow_problem(node)) is not None:
+                message = f"{node.kind.replace('_', ' ')} cannot be written in KRL: {problem}"
+                found.append(Diagnostic("error", "flow", message, node.span))
+        return found
 
 
 def _ambiguity(robot: Any, step: Step) -> list[Diagnostic]:

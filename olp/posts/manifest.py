@@ -16,6 +16,9 @@ The manifest says::
       max_instructions_per_file: null # instructions of any kind
       max_lines_per_file: null        # text lines, checked on the rendered files
     frames_in: world                  # or robot_base: the controller's reference for frames
+    rows: true                        # the templates write a "rows" step (runs of linear moves)
+                                      # with the post's row writer (default false: one step
+                                      # per move, as a copied folder of an older post has it)
     options: {...}                    # free-form: templates see them as `options`, and so does
                                       # the post class
 
@@ -55,6 +58,7 @@ class PostManifest:
     main_files: tuple[tuple[str, str], ...] = ()
     limits: SplitLimits = field(default_factory=SplitLimits)
     frames_in: str = "world"
+    rows: bool = False
 
 
 def load_manifest(folder: Path) -> PostManifest:
@@ -72,6 +76,9 @@ def load_manifest(folder: Path) -> PostManifest:
     frames_in = str(raw.get("frames_in", "world"))
     if frames_in not in FRAMES_IN:
         raise PostError(f"{path}: frames_in must be one of {', '.join(FRAMES_IN)}")
+    rows = raw.get("rows", False)
+    if not isinstance(rows, bool):
+        raise PostError(f"{path}: rows must be true or false, got {rows!r}")
     return PostManifest(
         name=str(raw.get("name", folder.name)),
         vendor=str(raw.get("vendor", "")),
@@ -84,6 +91,7 @@ def load_manifest(folder: Path) -> PostManifest:
         main_files=main_files,
         limits=limits,
         frames_in=frames_in,
+        rows=rows,
     )
 
 

@@ -51,6 +51,8 @@ from typing import TYPE_CHECKING, Any
 from olp import progress
 from olp.diagnostics import Diagnostic
 from olp.errors import PostError
+from olp.posts.flow import weave
+from olp.posts.rows import PostRows
 from olp.posts.text import basename
 from olp.posts.view import Allocation, Modal, Names, PostFrame, PostStep, PostTool, ProgramView
 from olp.transforms.split import SplitLimits, part_names, split_steps
@@ -68,14 +70,14 @@ class RenderError(Exception):
         self.diagnostics = tuple(diagnostics)
 
 
-class TrackedSteps(list[PostStep]):
+class TrackedSteps(list[PostStep | PostRows]):
     """A file's steps; iterating them tells the post which instruction is being written."""
 
-    def __init__(self, steps: Sequence[PostStep], post: Post) -> None:
+    def __init__(self, steps: Sequence[PostStep | PostRows], post: Post) -> None:
         super().__init__(steps)
         self.post = post
 
-    def __iter__(self) -> Iterator[PostStep]:
+    def __iter__(self) -> Iterator[PostStep | PostRows]:
         for step in super().__iter__():
             self.post.current_step = step
             yield step
@@ -99,6 +101,8 @@ def render(compiled: CompiledProgram, post: Post, name: str | None = None) -> di
     limits = manifest.limits
     for _ in range(_MAX_SPLIT_ROUNDS):
         parts = split_steps(compiled.steps, limits)
+        if len(parts) > 1 and compiled.program.has_flow:
+            raise RenderError([_no_split(compiled, len(parts))])
         post.problems, post.collecting = [], True
         try:
             files = renderer.render(parts)
@@ -111,6 +115,14 @@ def render(compiled: CompiledProgram, post: Post, name: str | None = None) -> di
             return files
         limits = _finer(limits, parts, lines, manifest.limits.max_lines, longest, renderer)
     raise PostError(f"post {manifest.name!r}: could not meet max_lines_per_file by splitting")
+
+
+def _no_split(compiled: CompiledProgram, parts: int) -> Diagnostic:
+    message = (
+        f"the program would be split into {parts} parts to meet the post's limits, and olp does "
+        "not split a program with control flow (a block cannot span two files)"
+    )
+    return Diagnostic("error", "split", message)
 
 
 def _unique(found: Sequence[Diagnostic]) -> list[Diagnostic]:
@@ -207,6 +219,8 @@ class _Renderer:
         unit_name: str | None = None,
     ) -> dict[str, Any]:
         view = self.view.unit_steps(steps, allocation)
+        if self.post.WRITES_FLOW and self.compiled.program.has_flow:
+            view = weave(self.compiled.program, view)
         tools, frames = _used(allocation, [s.index for s in view])
         name = unit_name or self.name
         return {
@@ -221,7 +235,7 @@ class _Renderer:
                 "is_main": index == 0,
             },
             "parts": [],
-            "steps": TrackedSteps(view, self.post),
+            "steps": TrackedSteps(self.post.group(view), self.post),
             "tools": tools,
             "frames": frames,
             "vendor": self.post.context_values(view),

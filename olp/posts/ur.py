@@ -69,6 +69,7 @@ from olp.diagnostics import Diagnostic
 from olp.ir import ArcOrientation
 from olp.posts.base import Filter, Post
 from olp.posts.numbers import NumberFormat
+from olp.posts.sandbox import SafeText
 from olp.posts.text import NUMBER, ArgumentRule, CommentRule, NameRule
 from olp.vendors.ur import (
     MOTION_DECIMALS,
@@ -79,6 +80,7 @@ from olp.vendors.ur import (
 
 if TYPE_CHECKING:
     from olp.compiled import CompiledProgram
+    from olp.posts.rows import PostRows
     from olp.posts.view import PostStep
 
 _KEYWORDS = """
@@ -138,25 +140,27 @@ def ur_joints(post: Post, joints: ArrayLike) -> str:
 
 def movej_speed(post: Post, speed: Any, robot: Any) -> str:
     """``v`` of ``movej`` in rad/s (:func:`olp.vendors.ur.movej_parameters`)."""
-    v = movej_parameters(speed.joint, speed.joint_acceleration, robot.limits.velocity)[1]
+    v = movej_parameters(speed.joint, speed.joint_acceleration, robot.limits.velocity, False)[1]
     return post.number("speed", v)
 
 
 def movej_acceleration(post: Post, speed: Any) -> str:
     """``a`` of ``movej`` in rad/s² (:func:`olp.vendors.ur.movej_parameters`; it does not
     depend on the axes' limits)."""
-    a = movej_parameters(speed.joint, speed.joint_acceleration, [1.0])[0]
+    a = movej_parameters(speed.joint, speed.joint_acceleration, [1.0], False)[0]
     return post.number("acceleration", a)
 
 
 def movel_acceleration(post: Post, speed: Any) -> str:
     """``a`` of ``movel``/``movec`` in m/s² (:func:`olp.vendors.ur.movel_parameters`)."""
-    return post.number("acceleration", movel_parameters(speed.linear, speed.linear_acceleration)[0])
+    a = movel_parameters(speed.linear, speed.linear_acceleration, False)[0]
+    return post.number("acceleration", a)
 
 
 def linear_speed(post: Post, speed: Any) -> str:
     """``v`` of ``movel``/``movec`` in m/s (:func:`olp.vendors.ur.movel_parameters`)."""
-    return post.number("speed", movel_parameters(speed.linear, speed.linear_acceleration)[1])
+    v = movel_parameters(speed.linear, speed.linear_acceleration, False)[1]
+    return post.number("speed", v)
 
 
 def radius(post: Post, value: float) -> str:
@@ -167,6 +171,35 @@ def radius(post: Post, value: float) -> str:
 def seconds(post: Post, value: float) -> str:
     """A ``sleep`` time in seconds (3 decimals)."""
     return post.number("sleep", value)
+
+
+def ur_rows(post: Post, rows: PostRows) -> SafeText:
+    """The lines of a run of ``movel`` (:mod:`olp.posts.rows`), exactly as
+    ``program.script.j2`` writes each: ``set_tcp`` where the tool changes, then
+    ``movel(p[..], a=.., v=.., r=..)`` with the target in the robot's Base frame. Poses, speeds
+    and radii are formatted as columns; every piece is a checked number, so the lines are
+    :class:`~olp.posts.sandbox.SafeText`."""
+    steps = rows.steps
+    v = pose_to_ur(np.stack([s.base_pose for s in steps]))  # type: ignore[misc]
+    xyz = post.number_column("position", v[:, :3], steps)
+    rot = post.number_column("angle", v[:, 3:], steps)
+    speeds = post.number_column("speed", [s.speed.linear for s in steps], steps)
+    radii = post.number_column("radius", [s.zone.radius for s in steps], steps)
+    accelerations: dict[Any, str] = {}
+    lines: list[str] = []
+    for k, step in enumerate(steps):
+        post.current_step = step
+        if step.new_tool:
+            assert step.tool is not None
+            lines.append(f"  set_tcp({ur_pose(post, step.tool.pose)})")  # type: ignore[arg-type]
+        a = accelerations.get(step.speed)
+        if a is None:
+            a = accelerations[step.speed] = movel_acceleration(post, step.speed)
+        p = 3 * k
+        pose = f"p[{xyz[p]}, {xyz[p + 1]}, {xyz[p + 2]}, {rot[p]}, {rot[p + 1]}, {rot[p + 2]}]"
+        lines.append(f"  movel({pose}, a={a}, v={speeds[k]}, r={radii[k]})")
+    post.current_step = rows
+    return SafeText("\n".join(lines))
 
 
 def _via_filter(post: Post, step: PostStep) -> str:
@@ -206,6 +239,7 @@ FILTERS: Mapping[str, Filter] = {
     "ur_radius": radius,
     "ur_seconds": seconds,
     "ur_movec_mode": movec_mode,
+    "ur_rows": ur_rows,
 }
 
 
@@ -228,6 +262,7 @@ class UrPost(Post):
     LANGUAGE = "URScript"
     NAME_RULE = NAME_RULE
     COMMENTS = CommentRule(collapse=True)
+    ROWS = True
     IO_RANGE = (0, 9)
     CALL_ARGUMENTS = ArgumentRule(_LITERAL, 'numbers and "strings" without " or \\')
     ACCELERATIONS: ClassVar[frozenset[str]] = frozenset({"linear_acceleration"})

@@ -414,6 +414,10 @@ def changed(last: dict[str, Any], key: str, value: Any) -> bool:
 
 
 def _same(a: Any, b: Any) -> bool:
+    if a is b:
+        return True
+    if type(a) is tuple and type(b) is tuple:
+        return bool(a == b)
     if hasattr(a, "pose") and hasattr(b, "pose"):
         return bool(a.name == b.name and np.array_equal(a.pose, b.pose))
     if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):

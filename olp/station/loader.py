@@ -21,6 +21,9 @@ Station file::
       - {name: plate, frame: fixture_1, geometry: [{box: {size: [300, 200, 10]}}]}
     fixtures:
       - {name: vice, frame: table, geometry: [{mesh: {file: vice.stl}}]}
+    targets:                           # named targets (RoboDK's target items)
+      - {name: Home, joints_deg: [0, -90, 90, 0, 0, 0]}
+      - {name: Approach, frame: table, pose: {xyz: [100, 50, 120], zyx: [0, 180, 0]}}
 
 Instead of ``model:`` a station may define the robot inline with the keys of a library file
 (``name``, ``vendor``, ``kinematics``, ``limits``, ``home_deg``, ``collision``,
@@ -85,7 +88,15 @@ from olp.station.fields import (
     text,
 )
 from olp.station.meshes import MeshError, mesh_hull
-from olp.station.model import JointLimits, Robot, Shape, Station, StationObject, ToolBody
+from olp.station.model import (
+    JointLimits,
+    NamedTarget,
+    Robot,
+    Shape,
+    Station,
+    StationObject,
+    ToolBody,
+)
 from olp.station.schema import KEYS, OPW_KEYS, PRIMITIVE_KINDS, UR_KEYS
 from olp.yamlsafe import KeyPath, UnreadableFile, read_regular_file, read_yaml, shorten
 
@@ -575,6 +586,7 @@ def load_station(path: str | Path) -> Station:
         *_objects(src, top.get("parts"), ("parts",), "part", frames, seen),
         *_objects(src, top.get("fixtures"), ("fixtures",), "fixture", frames, seen),
     )
+    targets = _targets(src, top.get("targets"), ("targets",), robot, frames)
     names = {"base", *(s.link for s in robot.collision), *tools, *seen}
     station_name = path.stem if top.get("name") is None else name(src, top["name"], ("name",))
     return Station(
@@ -587,7 +599,50 @@ def load_station(path: str | Path) -> Station:
         frame_parents=parents,
         objects=objects,
         allowed_pairs=_pairs(src, top.get("allowed_pairs"), ("allowed_pairs",), names),
+        targets=targets,
     )
+
+
+def _targets(
+    src: Source, value: Any, path: KeyPath, robot: Robot, frames: dict[str, Frame]
+) -> dict[str, NamedTarget]:
+    """Named targets: a ``pose`` (the TCP in ``frame``) or ``joints_deg`` inside the limits."""
+    out: dict[str, NamedTarget] = {}
+    for i, item in enumerate(items(src, value, path)):
+        where: KeyPath = (*path, i)
+        check_keys(src, item, where, KEYS["target"])
+        target_name = name(src, get(src, item, where, "name"), (*where, "name"))
+        if target_name in out:
+            raise src.error((*where, "name"), f"duplicate target name '{target_name}'")
+        if "description" in item:
+            text(src, item["description"], (*where, "description"))
+        frame = text(src, item.get("frame", "world"), (*where, "frame"))
+        if frame != "world" and frame not in frames:
+            raise src.error(
+                (*where, "frame"),
+                f"unknown frame '{shorten(frame)}' "
+                f"(frames: {shorten(', '.join(frames) or 'none')})",
+            )
+        if ("pose" in item) == ("joints_deg" in item):
+            raise src.error(where, "give a target either a 'pose' or 'joints_deg', exactly one")
+        if "pose" in item:
+            pose = _pose(src, item["pose"], (*where, "pose"))
+            out[target_name] = NamedTarget(target_name, frame, pose=pose)
+            continue
+        joints = np.radians(
+            numbers(src, item["joints_deg"], (*where, "joints_deg"), robot.dof, ANGLE)
+        )
+        outside = np.flatnonzero(robot.limits.violations(joints))
+        if outside.size:
+            axis = int(outside[0])
+            raise src.error(
+                (*where, "joints_deg", axis),
+                f"joint {axis + 1} lies outside its limits "
+                f"({math.degrees(robot.limits.lower[axis]):g} to "
+                f"{math.degrees(robot.limits.upper[axis]):g} deg)",
+            )
+        out[target_name] = NamedTarget(target_name, frame, joints=joints)
+    return out
 
 
 def _pairs(src: Source, value: Any, path: KeyPath, names: set[str]) -> tuple[tuple[str, str], ...]:

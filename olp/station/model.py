@@ -245,11 +245,32 @@ class StationObject:
 
 
 @dataclass(frozen=True, slots=True, eq=False)
+class NamedTarget:
+    """A target the station names (RoboDK's target items): either a Cartesian ``pose`` (4, 4)
+    of the TCP in ``frame``, metres, or controller ``joints`` (dof,) rad. ``frame`` is a station
+    frame or ``"world"``; a joint target keeps it as its place in the item tree."""
+
+    name: str
+    frame: str = "world"
+    pose: FloatArray | None = None
+    joints: FloatArray | None = None
+
+    def __post_init__(self) -> None:
+        if (self.pose is None) == (self.joints is None):
+            raise ValueError(f"target {self.name!r}: give a pose or joints, exactly one")
+        if self.pose is not None:
+            object.__setattr__(self, "pose", _frozen(self.pose, (4, 4)))
+        if self.joints is not None:
+            joints = np.array(self.joints, dtype=np.float64)
+            object.__setattr__(self, "joints", _frozen(joints, joints.shape))
+
+
+@dataclass(frozen=True, slots=True, eq=False)
 class Station:
     """A robot cell: the robot, named tools (TCP in flange) and frames (pose in world), the
     tools' bodies, each frame's parent frame, and the parts and fixtures. ``allowed_pairs``: pairs
     of body names (robot links, tools, parts, fixtures) the station allows to touch: never checked
-    for collisions."""
+    for collisions. ``targets``: the station's named targets (:class:`NamedTarget`) by name."""
 
     name: str
     robot: Robot
@@ -260,6 +281,7 @@ class Station:
     frame_parents: Mapping[str, str] = field(default_factory=dict)
     objects: tuple[StationObject, ...] = ()
     allowed_pairs: tuple[tuple[str, str], ...] = ()
+    targets: Mapping[str, NamedTarget] = field(default_factory=dict)
 
     def tool(self, ref: Tool) -> Tool | None:
         """The station's definition for a tool reference (by name, then number), or None."""

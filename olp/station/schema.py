@@ -235,6 +235,19 @@ _OBJECT = _object(
     ("name", "geometry"),
 )
 
+_TARGET = _object(
+    {
+        "name": _NAME,
+        "description": {"type": "string"},
+        "frame": {"type": "string", "description": "station frame the pose is given in"},
+        "pose": {**_ref("pose"), "description": "the TCP in the frame (any tool), mm and deg"},
+        "joints_deg": _numbers("controller joints, degrees"),
+    },
+    ("name",),
+    description="A named target: a Cartesian pose in a frame, or joints (exactly one).",
+    oneOf=[{"required": ["pose"]}, {"required": ["joints_deg"]}],
+)
+
 STATION: dict[str, Any] = {
     "$schema": "https://json-schema.org/draft/2020-12/schema",
     "title": "olp station",
@@ -256,6 +269,7 @@ STATION: dict[str, Any] = {
             "frames": {"type": "array", "items": _ref("frame")},
             "parts": {"type": "array", "items": _ref("object")},
             "fixtures": {"type": "array", "items": _ref("object")},
+            "targets": {"type": "array", "items": _ref("target")},
             "allowed_pairs": {**_PAIRS, "description": "links, tools, parts that may touch"},
         },
         ("robot",),
@@ -266,6 +280,7 @@ STATION: dict[str, Any] = {
         "tool": _TOOL,
         "frame": _FRAME,
         "object": _OBJECT,
+        "target": _TARGET,
         "robot_model": ROBOT_MODEL,
     },
 }
@@ -288,6 +303,7 @@ KEYS: dict[str, set[str]] = {
     "tool": keys(_TOOL),
     "frame": keys(_FRAME),
     "object": keys(_OBJECT),
+    "target": keys(_TARGET),
     "coupling": keys(_COUPLING["items"]),
     "dh_row": keys(_KINEMATICS["properties"]["rows"]["items"]),
     **{kind: keys(schema) for kind, schema in _PRIMITIVES.items()},

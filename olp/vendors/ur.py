@@ -90,23 +90,29 @@ rounded to them, so the timing uses the numbers the script says."""
 
 
 def movej_parameters(
-    joint: float, joint_acceleration: float, velocity_limits: ArrayLike
+    joint: float, joint_acceleration: float, velocity_limits: ArrayLike, written: bool = True
 ) -> tuple[float, float]:
     """``(a, v)`` of ``movej``: rad/s² and rad/s of the leading axis (URScript manual,
     ``movej``: "a: joint acceleration of leading axis [rad/s^2], v: joint speed of leading
     axis [rad/s]"). ``v`` is ``joint`` (fraction of each axis' maximum) times the *smallest*
     axis velocity limit, so that at 100 % no axis exceeds its own; ``a`` is 1.4 rad/s² times
-    ``joint_acceleration`` (UR publishes no joint acceleration limits)."""
+    ``joint_acceleration`` (UR publishes no joint acceleration limits). ``written``: rounded
+    as the script prints them (the post formats the unrounded values itself, to the same
+    text)."""
     v = joint * float(np.min(np.asarray(velocity_limits, dtype=np.float64)))
-    return _written(joint_acceleration * MOVEJ_ACCELERATION), _written(v)
+    a = joint_acceleration * MOVEJ_ACCELERATION
+    return (_written(a), _written(v)) if written else (a, v)
 
 
-def movel_parameters(linear: float, linear_acceleration: float | None) -> tuple[float, float]:
+def movel_parameters(
+    linear: float, linear_acceleration: float | None, written: bool = True
+) -> tuple[float, float]:
     """``(a, v)`` of ``movel``/``movec``: m/s² and m/s of the tool (URScript manual, ``movel``:
     "a: tool acceleration [m/s^2], v: tool speed [m/s]"): the programmed path acceleration, or
-    URScript's default, and the programmed TCP speed."""
+    URScript's default, and the programmed TCP speed (``written`` as for
+    :func:`movej_parameters`)."""
     a = MOVEL_ACCELERATION if linear_acceleration is None else linear_acceleration
-    return _written(a), _written(linear)
+    return (_written(a), _written(linear)) if written else (a, linear)
 
 
 def _written(value: float) -> float:

@@ -514,3 +514,13 @@ def test_fuzz_mutated_valid_program(station: Station, data: st.DataObject) -> No
 def test_seed_program_runs_clean(station: Station) -> None:
     result = run_dsl(SEED, "fuzz.py", station)
     assert result.program.name == "Fuzzed" and len(result.program) == 10
+
+
+def test_set_tool_takes_a_station_tool_number(station: Station) -> None:
+    """Issue 16: ``robot.setTool(1)`` said "Mat needs 4 x 4 numbers, got shape ()"; a number
+    is the station's tool of that controller number, an unknown one a located error."""
+    move = only("robot.setTool(1)\nrobot.MoveJ('home')\n", station)
+    assert move.tool is station.tools["spindle"]  # type: ignore[union-attr]
+    error = error_of("x = 1\nrobot.setTool(7)\n", station)
+    assert error.span is not None and error.span.line == 2
+    assert "no tool number 7 (tools: 1 spindle)" in error.message

@@ -357,3 +357,58 @@ def test_in_process_runs_stay_available_for_trusted_text(station: Station) -> No
         run_dsl(HOME + "raise KeyboardInterrupt\n", "prog.py", station)
     with pytest.raises(ParseError):
         run_dsl("x = 1\n", "prog.py", station)
+
+
+def test_a_circular_move_comes_back_from_the_child(tmp_path: Path, station: Station) -> None:
+    """A circular move holds an :class:`~olp.ir.ArcOrientation` (an enumeration): the result
+    reader took only olp's data classes, so every program with a MoveC failed to come back."""
+    text = (
+        "robot.setPoseFrame('table')\n"
+        "robot.MoveJ(Pose(0, 0, 100, 180, 0, 180))\n"
+        "robot.MoveC(Pose(50, 50, 100, 180, 0, 180), Pose(100, 0, 100, 180, 0, 180))\n"
+    )
+    result = load_dsl(program(tmp_path, text), station)
+    arc = result.program.instructions[-1]
+    assert isinstance(arc, ir.CircularMove) and isinstance(arc.orientation, ir.ArcOrientation)
+    assert arc == run_dsl(text, str(tmp_path / "prog.py"), station).program.instructions[-1]
+
+
+FORGE = """
+from olp.dsl import session
+from olp import ir
+
+
+def forged(cls, **values):
+    obj = object.__new__(cls)  # no constructor: none of its checks run
+    for key, value in values.items():
+        object.__setattr__(obj, key, value)
+    return obj
+
+
+robot.MoveJ([0, -90, 90, 0, 30, 0])
+session().record(forged(ir.{cls}, span=ir.SourceSpan("prog.py", 14, 1), {fields}))
+"""
+
+
+@pytest.mark.parametrize(
+    ("cls", "fields", "why"),
+    [
+        (
+            "Verbatim",
+            "text='WAIT SEC 1\\nLIN {X 0,Y 0,Z 0,A 0,B 0,C 0}', language='krl', reason='', "
+            "kind='verbatim'",
+            "must be one line",
+        ),
+        ("Wait", "seconds=-5.0, kind='wait'", "Wait"),
+    ],
+)
+def test_an_instruction_forged_in_the_child_is_an_error_not_output(
+    station: Station, tmp_path: Path, cls: str, fields: str, why: str
+) -> None:
+    """The child's result is unpickled without running the IR's checks; the parent makes every
+    object again through its constructor, so a forged one is a located error on the program."""
+    path = program(tmp_path, FORGE.replace("{cls}", cls).replace("{fields}", fields))
+    error = child_error(path, station)
+    assert "does not allow" in str(error) and why in str(error)
+    done = olp_cli("build", CELL, path, "--post", "kuka", "-o", tmp_path / "out", cwd=tmp_path)
+    assert done.returncode == 2 and not (tmp_path / "out").exists()

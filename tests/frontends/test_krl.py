@@ -146,8 +146,9 @@ def test_names_that_start_with_keywords_are_names() -> None:
         "LIN_ON()",
         "WAIT SEC LINE + PTPX + endless",
     )
-    assert [i.span.line for i in result.ignored] == [5]  # constant assignments are evaluated
-    assert [without_span(i) for i in result.program] == [
+    assert not result.ignored  # assignments are kept (and evaluated), the FOR is a block
+    assert [i.kind for i in result.program.instructions] == ["assign"] * 3 + ["for", "call", "wait"]
+    assert [without_span(i) for i in result.program if i.kind in ("call", "wait")] == [
         ir.Call(name="LIN_ON"),
         ir.Wait(seconds=6.0),
     ]
@@ -350,19 +351,24 @@ def test_unlowered_statements_are_listed_with_their_lines() -> None:
     )
     lines = [(i.span.line, i.text) for i in result.ignored]
     assert lines == [
-        (2, "DECL INT i"),
         (3, "GLOBAL INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )"),
         (4, "INTERRUPT ON 3"),
         (5, "BAS (#INITMOV,0 )"),
-        (6, "$ADVANCE = 3"),
-        (7, "i = i + 1"),
-        (8, "IF $IN[1] == TRUE THEN"),
-        (12, "HALT"),
         (13, "RETURN"),
         (14, f"LIN {FULL}"),
     ]
     assert all(i.reason for i in result.ignored)
-    assert len(result.program) == 1
+    kinds = [(i.kind, i.span.line) for i in result.program.instructions]
+    assert kinds == [
+        ("declare", 2),
+        ("verbatim", 6),  # $ADVANCE is a controller setting: kept as written
+        ("assign", 7),
+        ("if", 8),
+        ("linear", 11),
+        ("verbatim", 12),  # HALT
+    ]
+    block = result.program.instructions[3]
+    assert isinstance(block, ir.If) and [i.kind for i in block.branches[0].body] == ["assign"]
 
 
 def test_other_routines_are_listed() -> None:
@@ -380,7 +386,8 @@ def test_other_routines_are_listed() -> None:
     [
         ("LIN {X 1,Y 2,Z}", 15, "'}'"),
         ("PTP {A1 abc}", 9, "'abc'"),
-        ("FOO BAR BAZ", 5, "'BAR'"),
+        ("FOO BAR", 5, "'BAR'"),  # not a declaration: FOO is no type declared without DECL
+        ("FOO BAR BAZ", 9, "'BAZ'"),
         ("WAIT SEC", 9, "end of line"),
         ("x = 1 ? 2", 7, "'?'"),
         ("  LIN {X 1,Y 2,Z 3,A 0,B 0,C 0} C_FOO", 33, "'C_FOO'"),
@@ -408,10 +415,12 @@ def test_error_location_and_text(line: str, column: int, found: str) -> None:
     assert error.format().splitlines()[2].index("^") == 4 + column - 1
 
 
-def test_error_in_control_flow_body_points_at_the_statement() -> None:
-    error = parse_error("IF $IN[1] THEN", f"  LIN {FULL}", "ENDIF")
-    assert error.span is not None and (error.span.line, error.span.column) == (3, 3)
-    assert "control flow" in error.message
+def test_motion_settings_that_differ_between_paths_are_an_error_at_the_motion() -> None:
+    error = parse_error("IF $IN[1] THEN", "  $VEL.CP = 0.5", "ENDIF", f"LIN {FULL}")
+    assert error.span is not None and (error.span.line, error.span.column) == (5, 1)
+    assert "the speed differs between the paths of the IF at line 2" in error.message
+    settled = parse("IF $IN[1] THEN", "  $VEL.CP = 0.5", "ENDIF", "$VEL.CP = 0.2", f"LIN {FULL}")
+    assert [m.speed.linear for m in settled.program.motions()] == [0.2]
 
 
 @pytest.mark.parametrize(
@@ -421,7 +430,6 @@ def test_error_in_control_flow_body_points_at_the_statement() -> None:
         ("DEF a()\n", 1, "expected a statement or 'END'"),
         ("DEFDAT a PUBLIC\nDECL INT i\nENDDAT\n", 1, "DEFDAT a is not supported"),
         ("DEF a()\nEND\nLIN {X 1}\n", 3, "unexpected 'LIN'"),
-        ("DEFFCT INT f()\nENDFCT\n", 1, "must be a DEF"),
     ],
 )
 def test_file_level_errors(text: str, line: int, message: str) -> None:
@@ -498,7 +506,7 @@ def test_fuzz_mutated_programs(data: st.DataObject) -> None:
 
 def test_nesting_too_deep_is_a_parse_error() -> None:
     deep = parse("x = " + "(" * 3000 + "1" + ")" * 3000, "WAIT SEC x")  # parentheses add no depth
-    assert [without_span(i) for i in deep.program] == [ir.Wait(seconds=1.0)]
+    assert [without_span(i) for i in deep.program][1:] == [ir.Wait(seconds=1.0)]
     error = parse_error("x = " + "-" * 3000 + "1")
     assert error.span is not None and error.span.line == 1
     assert "nested too deeply" in error.message

@@ -173,6 +173,8 @@ def test_milling_program(milling: KrlResult) -> None:
     assert {m.tool.name for m in motions} == {"tool_l10"}
     assert [(i.span.line, i.text) for i in milling.ignored] == [(5, "BAS (#INITMOV,0 )")]
     assert {m.speed.linear_acceleration for m in cutting} == {2.0}
+    kept = [(i.span.line, i.text) for i in milling.program if isinstance(i, ir.Verbatim)]
+    assert kept == []  # $ACC.CP is a motion parameter olp models: lowered, not kept
     assert milling.notes == ()
 
 

@@ -39,7 +39,13 @@ def test_the_default_pipeline_is_resolve_collide_time(
 ) -> None:
     compiled = olp.compile(milling, station)
     assert compiled.ok and compiled.cycle_time > 0
-    assert [p.__name__ for p in PIPELINE] == ["resolve_pass", "collision_pass", "timing_pass"]
+    assert [p.__name__ for p in PIPELINE] == [
+        "resolve_pass",
+        "flow_pass",  # a no-op without control flow (olp.passes.flow)
+        "collision_pass",
+        "timing_pass",
+        "flow_timing_note",
+    ]
     checked = olp.compile(milling, station, passes=CHECKS)
     assert checked.ok and checked.cycle_time == 0.0  # no timing pass
     assert [s.joints.tolist() for s in checked.motion_steps() if s.joints is not None] == [
@@ -72,8 +78,9 @@ def test_a_pass_of_ones_own_is_one_function(milling: ir.Program, station: Statio
         target=ir.CartesianTarget(pose=station.robot.flange_poses(home.target.joints))
     )  # type: ignore[union-attr]
     program = ir.Program(name="p", instructions=(home, still, still))
-    resolve, collide, time = PIPELINE
-    compiled = olp.compile(program, station, passes=(resolve, thin_points, resolve, collide, time))
+    resolve, flow, collide, time, _ = PIPELINE
+    passes = (resolve, thin_points, resolve, flow, collide, time)
+    compiled = olp.compile(program, station, passes=passes)
     assert [d.message for d in compiled.diagnostics if d.kind == "thinned"] == ["2 moves dropped"]
     assert [s.instruction.kind for s in compiled.steps] == ["joint"]
     assert compiled.ok and compiled.cycle_time > 0

@@ -66,3 +66,24 @@ def test_absurd_programs_give_diagnostics_not_exceptions(seed: int) -> None:
     crashes: list[str] = []
     _fuzz_module().run(15, seed, lambda k, text: crashes.append(f"program {k}: {text}"))
     assert crashes == []
+
+
+def test_a_huge_zone_timed_as_a_stop_is_an_info_without_a_warning(station: Station) -> None:
+    """A LIN with a 1e308 m zone before a PTP: the zone-stop note multiplied a numpy float by
+    1000 and numpy warned of the overflow (found by benchmarks/fuzz_passes.py)."""
+    import warnings
+
+    import numpy as np
+
+    from olp import ir
+
+    at = station.robot.flange_poses(station.robot.home)
+    moves = (
+        ir.LinearMove(target=ir.CartesianTarget(pose=at), zone=ir.Zone(1e308)),
+        ir.JointMove(target=ir.JointTarget(joints=station.robot.home + np.radians(5.0))),
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        result = build(station, ir.Program(name="t", instructions=moves), post="kuka")
+    notes = [d.message for d in result.diagnostics if d.kind == "zone_stop"]
+    assert notes and notes[0].startswith("zone of inf mm timed as an exact stop")

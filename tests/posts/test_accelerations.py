@@ -4,6 +4,7 @@ written back by every post, or warned where the language cannot say them."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,6 +14,7 @@ from olp import ir
 from olp.geometry import transl
 from olp.station.model import Station
 from tests.posts.test_all_posts import CELLS, READY, _lines
+from tests.posts.test_rows import _both, _moves
 
 
 @pytest.fixture(scope="module")
@@ -101,3 +103,26 @@ def test_linear_path_rows_carry_the_accelerations() -> None:
     )
     assert path.move(1).speed.linear_acceleration == 0.5
     assert path.move(1).speed.angular_acceleration == 1.0
+
+
+@pytest.mark.parametrize("post", ["kuka", "ur", "abb", "fanuc"])
+def test_row_writers_write_the_accelerations_as_the_templates(post: str, tmp_path: Path) -> None:
+    """A run of LINs whose path acceleration is set, changed and unset again: the row writer's
+    text is the templates' (tests/posts/test_rows.py), with the accelerations in it."""
+    program = _moves(24, tmp_path)
+    out = []
+    for k, node in enumerate(program.instructions):
+        if isinstance(node, ir.LinearMove) and 5 <= k < 15:
+            node = node.with_speed(linear_acceleration=0.5 if k < 10 else 1.5)
+        out.append(node)
+    rows, template = _both(post, program.replace_instructions(out))
+    assert rows.files == template.files
+    text = "".join(rows.files.values())
+    expected = {
+        "kuka": ["$ACC.CP = 0.5000", "$ACC.CP = 1.5000"],
+        "ur": ["a=0.50000", "a=1.50000", "a=1.20000"],
+        "abb": ["\\AccMax:=0.500", "\\AccMax:=1.500", "PathAccLim FALSE, FALSE;"],
+        "fanuc": [],
+    }[post]
+    for piece in expected:
+        assert piece in text

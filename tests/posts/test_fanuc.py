@@ -648,3 +648,23 @@ def test_j5_sign_rule_holds_on_the_m20ia() -> None:
     """N for J5 < 0 (VENDOR-NOTES, medium confidence): the hand-derived tool-down pose above."""
     assert str(fanuc.config_from_joints(_station().robot, TOOL_DOWN_Q)) == "N U T, 0, 0, 0"
     assert math.isclose(float(_station().robot.flange_poses(TOOL_DOWN_Q)[2, 3]), 0.825 + 0.94)
+
+
+def test_a_speed_too_slow_for_ls_is_written_at_its_least_with_a_warning() -> None:
+    station = _station()
+    at = station.robot.flange_poses(TOOL_DOWN_Q)
+    down = at.copy()
+    down[2, 3] -= 0.01
+    program = Program(
+        name="slow",
+        instructions=(
+            JointMove(target=JointTarget(joints=TOOL_DOWN_Q), tool=FLANGE).with_speed(joint=0.001),
+            LinearMove(target=CartesianTarget(pose=down), tool=FLANGE).with_speed(linear=0.0002),
+        ),
+    )
+    result = olp.build(station, program, "fanuc")
+    assert result.ok, [d.format() for d in result.diagnostics]
+    raised = [(d.index, d.severity) for d in result.diagnostics if d.kind == "speed_raised"]
+    assert raised == [(0, "warning"), (1, "warning")]
+    body = result.files["SLOW.ls"]
+    assert "J P[1] 1% FINE" in body and "L P[2] 1mm/sec FINE" in body

@@ -10,7 +10,11 @@ motion state) -> IR. Data lists (the module's ``.dat``, a ``$config.dat``) are r
 What is lowered
 ---------------
 * **Files.** ``&`` header lines, several ``DEF``/``DEFFCT`` routines, ``;FOLD`` comments. The
-  first ``DEF`` is the program. :func:`load_krl` reads the ``.dat`` beside the ``.src`` (same
+  first ``DEF`` is the program (a module of ``DEFFCT`` functions only is an empty program, each
+  function listed as not lowered). Declarations may leave out ``DECL`` for the simple and the
+  predefined structure types (``FRAME lfOffset``, ``E6AXIS XHOME={...}``, as a controller's
+  ``$config.dat`` writes them); parameters may be arrays (``sText[]:IN``) and functions may
+  return one (``DEFFCT CHAR[128]``). :func:`load_krl` reads the ``.dat`` beside the ``.src`` (same
   name, any case) and, if given, the controller's ``$config.dat``; their ``DECL``\\ s with values
   (``E6POS/POS/FRAME/E6AXIS/AXIS``, ``PDAT/LDAT/FDAT``, numbers, ...) and value assignments
   (``TOOL_DATA[1]={...}``, ``TOOL_NAME[1,]="..."``) are the program's global variables; the
@@ -61,22 +65,45 @@ What is lowered
   arguments are constant; others are unknown inside; parameters not marked ``:IN`` are copied
   back to a plain variable argument); recursion is an error. Other calls become
   :class:`~olp.ir.Call` (arguments as source text).
-* **FOR** loops with constant integer bounds are unrolled (at most
-  :data:`~olp.frontends.krl.lower.MAX_FOR_ITERATIONS` iterations, and
-  :data:`~olp.frontends.krl.lower.MAX_LOWERED_STATEMENTS` statements in all). Other control
-  flow (``IF``, ``WHILE``, ``LOOP``, ``REPEAT``, ``SWITCH``, FOR with other bounds) is ignored
-  when lowering its bodies would change nothing (variables they assign become unknown), and
-  rejected otherwise, naming the construct and its line. ``SPLINE ... ENDSPLINE`` blocks and
-  ``GOTO`` are rejected.
+* **Control flow** becomes :mod:`olp.ir_flow` blocks (re-exported from :mod:`olp.ir`): ``IF``
+  -> :class:`~olp.ir.If`, ``SWITCH`` -> :class:`~olp.ir.Switch`, ``WHILE``/``REPEAT``/``LOOP``
+  -> :class:`~olp.ir.While`/:class:`~olp.ir.Repeat`/:class:`~olp.ir.Loop`, ``EXIT`` ->
+  :class:`~olp.ir.Exit`, labels and ``GOTO`` -> :class:`~olp.ir.Label`/:class:`~olp.ir.Goto`,
+  conditions as :mod:`olp.ir_flow` expressions. Each body is lowered from the state that
+  reaches it; after a block, a variable keeps its value only where every path agrees, and a
+  motion setting (speed, zone, tool, base) that differs between the paths is an error at the
+  next motion that relies on it (the inline forms set them again, so pendant programs pass). A
+  loop's body starts from the join of the state before it and after a pass (variables it
+  assigns are unknown inside). ``FOR`` loops with constant integer bounds over straight-line
+  code are unrolled (at most :data:`~olp.frontends.krl.lower.MAX_FOR_ITERATIONS` iterations,
+  and :data:`~olp.frontends.krl.lower.MAX_LOWERED_STATEMENTS` statements in all); others are a
+  :class:`~olp.ir.For` block. A jump back to a label makes the variables the routine assigns
+  unknown there; one with other motion settings than the label had is an error. ``SPLINE ...
+  ENDSPLINE`` blocks are rejected. ``RETURN`` inside a block of an inlined routine is rejected.
+* **Motions to where the robot is** (``PTP $POS_ACT``, ``PTP $AXIS_ACT``: the block
+  coincidence run) are kept as written (:class:`olp.ir.Verbatim`): there is nothing to check.
+  A motion to a value derived from them at run time (``lNow.Z = lNow.Z + 100``, ``LIN lNow``)
+  is an error that says so.
+* **Data.** Declarations in the program are :class:`~olp.ir.Declare`, assignments of the
+  program's variables :class:`~olp.ir.Assign` (their constant values are also used, as before);
+  what the inline forms assign for BAS (``PDAT_ACT``, ``LDAT_ACT``, ``FDAT_ACT``) is absorbed
+  into the motions. ``WAIT FOR`` a condition other than an input is :class:`~olp.ir.WaitUntil`.
 * **I/O and waits.** ``WAIT SEC`` -> Wait; ``WAIT FOR $IN[n]`` (or ``NOT``, ``== TRUE/FALSE``, a
   one-bit ``SIGNAL``) -> WaitInput; ``$OUT[n] = TRUE/FALSE`` (or a SIGNAL) -> SetOutput.
 * **Variables.** Constant expressions are evaluated (KRL rules: INT/INT truncates); assignments
   of constants are kept for later use; others make the variable unknown and are listed.
 
 Nothing is dropped silently: every statement olp recognised but did not lower is in
-:attr:`KrlResult.ignored` with the reason (also those of the data lists). Text the grammar does
-not accept, and values olp needs but cannot use, raise :class:`olp.errors.ParseError` with file,
-line, column, what was expected and the offending text.
+:attr:`KrlResult.ignored` with the reason (also those of the data lists; the frontend reports
+the program's own as warnings). Statements that matter to the controller but that olp does not
+model (motion parameters such as ``$ACC.CP``, ``$VEL.ORI1``, ``$ADVANCE``; ``SET_CD_PARAMS``,
+``PULSE``, ``HALT``, ``BRAKE``, ``CONTINUE``, ``ON_ERROR_PROCEED``, ``RESUME``, motions to
+``$POS_ACT``) are kept in the program as :class:`olp.ir.Verbatim`: the KRL post writes them
+back, other posts stop on them. ``$ORI_TYPE``/``$CIRC_TYPE`` are motion settings (the arcs'
+orientation rule); for linear moves olp notes at each one that it does not model them.
+
+Text the grammar does not accept, and values olp needs but cannot use, raise
+:class:`olp.errors.ParseError` with file, line, column, what was expected and the offending text.
 """
 
 from __future__ import annotations

@@ -316,11 +316,20 @@ class ForLoop:
 
 @dataclass(frozen=True, slots=True)
 class Block:
-    """A control-flow statement (IF, WHILE, SPLINE, ...) with its bodies (IF: then and else)."""
+    """A control-flow statement (IF, WHILE, SPLINE, ...) with its bodies.
+
+    ``conditions``: IF and WHILE: the condition; REPEAT: the UNTIL condition; SWITCH: the
+    subject. ``bodies``: IF: then, else (empty if none); SWITCH: one per CASE, then the
+    DEFAULT's; others: the body. ``cases``: SWITCH: the values of each CASE. ``has_else``: an
+    IF's ELSE or a SWITCH's DEFAULT is written.
+    """
 
     keyword: str
     bodies: tuple[tuple[Stmt, ...], ...]
     span: ir.SourceSpan
+    conditions: tuple[Expr, ...] = ()
+    cases: tuple[tuple[Expr, ...], ...] = ()
+    has_else: bool = False
 
 
 @dataclass(frozen=True, slots=True)
@@ -329,6 +338,7 @@ class Other:
 
     kind: str
     span: ir.SourceSpan
+    name: str | None = None  # a label's or a GOTO's label name
 
 
 Stmt: TypeAlias = (
@@ -350,6 +360,7 @@ Stmt: TypeAlias = (
 class Param:
     name: str
     direction: str | None  # "IN", "OUT" or not given
+    array: bool = False  # written with empty brackets: sText[]:IN
 
 
 @dataclass(frozen=True, slots=True)

@@ -61,6 +61,8 @@ OTHER_REASONS = {
     "EXIT": "EXIT only matters inside a loop",
     "CONTINUE": "CONTINUE only affects the controller's advance run",
     "BRAKE": "BRAKE only matters in interrupt routines",
+    "RESUME": "RESUME (leave an interrupt routine) has no IR equivalent",
+    "ON_ERROR_PROCEED": "ON_ERROR_PROCEED (ignore the next statement's error) is not modelled",
 }
 
 

@@ -9,10 +9,13 @@ lowering it would change nothing, and rejected (naming the construct and its lin
 from __future__ import annotations
 
 import dataclasses
+import os
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
 from typing import Any
 
 from olp import ir
+from olp.errors import ParseError
 from olp.frontends.krl.ast import (
     Assign,
     Binary,
@@ -24,6 +27,7 @@ from olp.frontends.krl.ast import (
     FastMotion,
     ForLoop,
     IgnoredLine,
+    Index,
     Module,
     MotionStmt,
     Other,
@@ -37,6 +41,7 @@ from olp.frontends.krl.ast import (
     WaitSec,
 )
 from olp.frontends.krl.data import OTHER_REASONS, KrlData
+from olp.frontends.krl.flow import assigned_names, is_straight, jump_targets, statements, to_expr
 from olp.frontends.krl.motion import Motions
 from olp.frontends.krl.state import (
     DEFAULT_VEL_CP,
@@ -64,20 +69,86 @@ MAX_FOR_ITERATIONS = 1_000_000
 MAX_LOWERED_STATEMENTS = 2_000_000
 """Statements (and loop iterations) lowered in one run, counting every unrolled and inlined copy:
 bounds the time and memory a small file can ask for through nested loops."""
+_HERE = frozenset({"$POS_ACT", "$AXIS_ACT", "$POS_ACT_MES", "$AXIS_ACT_MES"})
+"""Targets that are where the robot stands when the motion starts."""
+
+
+def _is_here(var: Var) -> bool:
+    return not var.selectors and var.name.upper() in _HERE
+
+
+_KEPT_OTHERS = frozenset({"RESUME", "ON_ERROR_PROCEED", "HALT", "BRAKE", "CONTINUE"})
+"""Statements that change how the controller runs the program: kept as written."""
 _IGNORED_CALLS = {
     "SET_CD_PARAMS": "collision-detection parameters are not modelled",
     "PULSE": "PULSE outputs are not lowered yet",
 }
 
 
+@dataclass
+class RoutineJumps:
+    """The labels of one routine activation and what jumps to them: ``labels`` name -> line,
+    ``targets`` name -> the lines of its GOTOs, ``assigned`` the variables the routine assigns
+    anywhere; while lowering: the state each label was reached with (``seen``), the paths
+    of GOTOs that jump forward to a label not lowered yet (``pending``) and the states of the
+    GOTOs that jump back (``back_states``); ``first_pass``: those of a first lowering of the
+    routine, so that at a label the settings a later jump back brings are known.
+
+    A first pass is the honest price of jumps back: the label needs the state at a GOTO that
+    is lowered after it. Settings that differ there are ambiguous after the label."""
+
+    labels: dict[str, int] = field(default_factory=dict)
+    targets: dict[str, list[int]] = field(default_factory=dict)
+    assigned: set[str] = field(default_factory=set)
+    seen: dict[str, State] = field(default_factory=dict)
+    pending: dict[str, list[Any]] = field(default_factory=dict)
+    back_states: dict[str, list[State]] = field(default_factory=dict)
+    first_pass: dict[str, list[State]] = field(default_factory=dict)
+
+    @property
+    def jumps_back(self) -> bool:
+        return any(
+            line > self.labels.get(name, line)
+            for name, lines in self.targets.items()
+            for line in lines
+        )
+
+    @classmethod
+    def of(cls, body: Sequence[Stmt]) -> RoutineJumps:
+        labels = {
+            (s.name or "").upper(): s.span.line
+            for s in statements(body)
+            if isinstance(s, Other) and s.kind == "label"
+        }
+        return cls(labels, jump_targets(body), assigned_names(body))
+
+
 class _Lowering(Motions):
-    """Walks statements (inlining calls, unrolling FOR loops), appending IR."""
+    """Walks statements (inlining calls, unrolling constant FOR loops over straight-line code,
+    lowering blocks to :mod:`olp.ir_flow` blocks), appending IR.
+
+    ``ambiguous``: motion settings (fields of :class:`State`) that differ between the paths
+    reaching this point, and why; a motion before they are set again is an error.
+    """
 
     def __init__(self, ctx: Context, state: State, variables: Variables) -> None:
+        self.ambiguous: dict[str, str] = {}
+        self._state = state
         super().__init__(ctx, state, variables)
+        self.loops: list[str] = []  # the enclosing loops, innermost last: "block" or "unrolled"
+        self.in_block = 0
+        self.jumped: int | None = None  # line of a GOTO after which nothing is reached
+        self.routine = RoutineJumps()
+        self._blocks: dict[str, Callable[[Block], None]] = {
+            "IF": self._if,
+            "SWITCH": self._switch,
+            "WHILE": self._while,
+            "REPEAT": self._repeat,
+            "LOOP": self._loop,
+        }
         self._statements: dict[type, Callable[[Any], None]] = {
             FastMotion: self._fast_motion,
-            MotionStmt: self._motion,
+            MotionStmt: self._motion_or_here,
             Assign: self._assign,
             CallStmt: self._call,
             WaitSec: self._wait_sec,
@@ -88,6 +159,20 @@ class _Lowering(Motions):
             Block: self._block,
             Other: self._other,
         }
+
+    @property
+    def state(self) -> State:
+        return self._state
+
+    @state.setter
+    def state(self, new: State) -> None:
+        """Setting a motion setting again ends its ambiguity (a field assigned anew is a new
+        object, so identity tells which ones a statement set)."""
+        if self.ambiguous:
+            old = self._state
+            for name in [n for n in self.ambiguous if getattr(new, n) is not getattr(old, n)]:
+                del self.ambiguous[name]
+        self._state = new
 
     # ---- driving
     def lower_body(self, body: Sequence[Stmt]) -> None:
@@ -102,22 +187,46 @@ class _Lowering(Motions):
         if self.exiting is not None:
             self._ignore(stmt, f"not reached: the EXIT at line {self.exiting} leaves the loop")
             return
+        if self.jumped is not None and not (isinstance(stmt, Other) and stmt.kind == "label"):
+            self._ignore(stmt, f"not reached: the GOTO at line {self.jumped} jumps away")
+            return
+        if self.ambiguous and isinstance(stmt, MotionStmt | FastMotion):
+            reasons = "; ".join(sorted(set(self.ambiguous.values())))
+            raise self._error(
+                f"olp cannot tell which motion settings this motion runs with: {reasons}",
+                stmt.span,
+                hint="set them again before the motion (the pendant's inline forms do)",
+            )
         self.ctx.spend(stmt)
         try:
             self._statements[type(stmt)](stmt)
         except ir.IRError as exc:
             raise self._error(f"invalid value: {exc}", stmt.span) from None
 
-    def changed_anything(self, before: State) -> bool:
-        """True if lowering so far made IR or changed the state (a block cannot be skipped)."""
-        effects = self.out or self.status_turn or self.returned is not None
-        return bool(effects) or self.state != before
+    # ---- motions to where the robot is
+    def _motion_or_here(self, stmt: MotionStmt) -> None:
+        """``PTP $POS_ACT`` / ``PTP $AXIS_ACT`` (the block coincidence run of a program start)
+        move to where the robot already is: nothing to check, kept as written."""
+        target = stmt.targets[-1] if stmt.targets else None
+        simple = stmt.keyword in ("PTP", "SPTP", "LIN", "SLIN") and not stmt.with_clause
+        if simple and isinstance(target, Var) and _is_here(target):
+            self._keep(stmt, f"moves to where the robot already is ({target.name}): no motion")
+        else:
+            self._motion(stmt)
 
     # ---- declarations
     def _decl(self, stmt: Decl) -> None:
-        reason = self.data.declare(stmt, self.variables.declare)
-        if reason is not None:
-            self._ignore(stmt, reason)
+        """A declaration in a routine: its values are tracked, and it is kept in the program
+        (:class:`olp.ir.Declare`, one per name)."""
+        self.data.declare(stmt, self.variables.declare)
+        for item in stmt.items:
+            dims = tuple(to_expr(d, self._input_index) for d in item.dims or ())
+            value = None if item.value is None else self._expr(item.value)
+            self.out.append(
+                ir.Declare(
+                    name=item.name, type_name=stmt.type_name, dims=dims, value=value, span=stmt.span
+                )
+            )
 
     def _signal(self, stmt: SignalDecl) -> None:
         reason = self.data.signal(stmt, self.variables.declare)
@@ -137,7 +246,7 @@ class _Lowering(Motions):
                 f"{routine.name} is a function (DEFFCT): call it in an expression", stmt.span
             )
         elif name in _IGNORED_CALLS:
-            self._ignore(stmt, _IGNORED_CALLS[name])
+            self._keep(stmt, _IGNORED_CALLS[name])
         else:
             args = tuple("" if arg is None else self.sources.snippet(arg.span) for arg in stmt.args)
             self.out.append(ir.Call(name=stmt.name, args=args, span=stmt.span))
@@ -163,14 +272,17 @@ class _Lowering(Motions):
         bound = self._bind_params(routine, stmt)
         self.call_stack.append(name)
         self.variables.push(bound)
-        saved = self.returned, self.exiting, self.loop_depth
-        self.returned, self.exiting, self.loop_depth = None, None, 0
+        saved = self.returned, self.exiting, self.loop_depth, self.loops, self.routine, self.jumped
+        self.returned, self.exiting, self.loop_depth, self.loops = None, None, 0, []
+        self.routine, self.jumped = RoutineJumps.of(routine.body), None
         try:
+            self.first_pass(routine.body)
             self.lower_body(routine.body)
         finally:
             finals = self.variables.pop()
             self.call_stack.pop()
-            self.returned, self.exiting, self.loop_depth = saved
+            self.returned, self.exiting, self.loop_depth, self.loops, self.routine = saved[:5]
+            self.jumped = saved[5]
         self._write_back(routine, stmt, bound, finals)
 
     def _bind_params(self, routine: Routine, stmt: CallStmt) -> dict[str, Value]:
@@ -218,7 +330,8 @@ class _Lowering(Motions):
     def _wait_for(self, stmt: WaitFor) -> None:
         found = self._input_condition(stmt.condition)
         if found is None:
-            self._ignore(stmt, "only WAIT FOR $IN[n] (or its negation) is lowered yet")
+            condition = self._expr(stmt.condition)
+            self.out.append(ir.WaitUntil(condition=condition, span=stmt.span))
             return
         index, value = found
         self.out.append(ir.WaitInput(index=index, value=value, span=stmt.span))
@@ -244,17 +357,12 @@ class _Lowering(Motions):
 
     # ---- loops and other control flow
     def _for(self, stmt: ForLoop) -> None:
-        """Unrolled when its bounds are constant; otherwise like any other block."""
+        """Unrolled when its bounds are constant and its body is straight-line code; otherwise
+        lowered as an :class:`olp.ir.For` block (its counter unknown inside)."""
         parts = [stmt.start, stmt.end] + ([stmt.step] if stmt.step is not None else [])
-        values = [self._value(part) for part in parts]
-        numbers = [as_int(value) for value in values]
-        if any(n is None for n in numbers):
-            culprit = next(p for p, n in zip(parts, numbers, strict=True) if n is None)
-            why = (
-                f"olp unrolls FOR loops with constant integer bounds, and "
-                f"{self.sources.snippet(culprit.span)!r} is not one"
-            )
-            self._probe("FOR", (stmt.body,), stmt.span, why, loop=True)
+        numbers = [as_int(self._value(part)) for part in parts]
+        if any(n is None for n in numbers) or not is_straight(stmt.body):
+            self._for_block(stmt)
             return
         start, end = int(numbers[0] or 0), int(numbers[1] or 0)
         step = int(numbers[2]) if len(numbers) > 2 and numbers[2] is not None else 1
@@ -269,11 +377,32 @@ class _Lowering(Motions):
             )
         if not counts:
             self._ignore(stmt, f"the FOR loop runs 0 times ({start} TO {end} STEP {step})")
+        elif self._lowers_as_block(stmt):
+            self._for_block(stmt)
+            return
+        else:
+            self._ignore(
+                stmt,
+                f"the FOR loop is written out {len(counts)} times: what it does depends on "
+                f"{stmt.counter}, which olp knows only by unrolling it",
+            )
         self._unroll(stmt, counts)
+
+    def _lowers_as_block(self, stmt: ForLoop) -> bool:
+        """Whether the body lowers with the counter unknown (then the loop stays a loop)."""
+        probe = self._child(loop=True, probe=True)
+        unknown = Unknown(f"{stmt.counter} counts the FOR loop at line {stmt.span.line}")
+        probe.variables.assign(stmt.counter.upper(), unknown)
+        try:
+            probe.lower_body(stmt.body)
+        except ParseError:
+            return False
+        return True
 
     def _unroll(self, stmt: ForLoop, counts: range) -> None:
         counter = stmt.counter.upper()
         self.loop_depth += 1
+        self.loops.append("unrolled")
         try:
             for count in counts:
                 self.ctx.spend(stmt)
@@ -284,11 +413,25 @@ class _Lowering(Motions):
                     break
         finally:
             self.loop_depth -= 1
+            self.loops.pop()
         self.variables.assign(
             counter,
             Unknown(
                 f"olp does not track {stmt.counter} after its FOR loop (line {stmt.span.line})"
             ),
+        )
+
+    def _for_block(self, stmt: ForLoop) -> None:
+        counter = stmt.counter.upper()
+        unknown = Unknown(f"{stmt.counter} counts the FOR loop at line {stmt.span.line}")
+        self.variables.assign(counter, unknown)
+        body = self._loop_body(stmt.body, "FOR", stmt.span)
+        step = None if stmt.step is None else self._expr(stmt.step)
+        start, stop = self._expr(stmt.start), self._expr(stmt.end)
+        self.out.append(
+            ir.For(
+                variable=stmt.counter, start=start, stop=stop, step=step, body=body, span=stmt.span
+            )
         )
 
     def _block(self, stmt: Block) -> None:
@@ -299,59 +442,255 @@ class _Lowering(Motions):
                 stmt.span,
                 hint="olp lowers single SPTP, SLIN and SCIRC motions; write the segments as those",
             )
-        why = (
-            "olp lowers straight-line code, calls of the module's DEFs and FOR loops with "
-            f"constant bounds, not {stmt.keyword} (its IR has no control flow)"
-        )
-        loop = stmt.keyword in ("WHILE", "LOOP", "REPEAT")
-        self._probe(stmt.keyword, stmt.bodies, stmt.span, why, loop=loop)
+        self._blocks[stmt.keyword](stmt)
 
-    def _probe(
-        self,
-        keyword: str,
-        bodies: Sequence[Sequence[Stmt]],
-        span: ir.SourceSpan,
-        why: str,
-        loop: bool,
-    ) -> None:
-        """Ignore a block whose bodies change nothing olp lowers, else reject it. Variables the
-        bodies assign are unknown afterwards (olp cannot tell whether they ran)."""
-        changed: set[str] = set()
-        for body in bodies:
-            probe = _Lowering(self.ctx, self.state, self.variables.copy())
-            probe.track = dataclasses.replace(self.track)
-            probe.call_stack = list(self.call_stack)
-            probe.loop_depth = self.loop_depth + (1 if loop else 0)
-            for inner in body:
-                probe.lower_statement(inner)
-                left = probe.exiting is not None and not loop
-                if probe.changed_anything(self.state) or left:
-                    raise self._error(
-                        f"{self.sources.snippet(inner.span)!r} inside the {keyword} at line "
-                        f"{span.line} cannot be lowered: {why}",
-                        inner.span,
-                    )
-            changed |= probe.variables.changed_since(self.variables)
-        for name in sorted(changed):
-            reason = f"{name} may be assigned in the {keyword} at line {span.line}, which olp skips"
-            self.variables.assign(name, Unknown(reason))
-        self._ignore(
-            Other(keyword, span),
-            f"{keyword} block (lines {span.line}-{span.end_line}) changes nothing olp lowers",
+    def _if(self, stmt: Block) -> None:
+        condition = self._expr(stmt.conditions[0])
+        arms = [self._branch(body) for body in stmt.bodies]
+        self._join([child for child, _ in arms], "IF", stmt.span)
+        (_, then_body), (_, else_body) = arms
+        branch = ir.Branch(condition=condition, body=then_body, span=stmt.span)
+        self.out.append(ir.If(branches=(branch,), orelse=else_body, span=stmt.span))
+
+    def _switch(self, stmt: Block) -> None:
+        subject = self._expr(stmt.conditions[0])
+        arms = [self._branch(body) for body in stmt.bodies]
+        self._join([child for child, _ in arms], "SWITCH", stmt.span)
+        cases = tuple(
+            ir.Case(values=tuple(self._expr(v) for v in values), body=body, span=stmt.span)
+            for values, (_, body) in zip(stmt.cases, arms, strict=False)
         )
+        default = arms[-1][1]
+        self.out.append(ir.Switch(subject=subject, cases=cases, default=default, span=stmt.span))
+
+    def _while(self, stmt: Block) -> None:
+        condition = self._expr(stmt.conditions[0])
+        body = self._loop_body(stmt.bodies[0], "WHILE", stmt.span)
+        self.out.append(ir.While(condition=condition, body=body, span=stmt.span))
+
+    def _repeat(self, stmt: Block) -> None:
+        body = self._loop_body(stmt.bodies[0], "REPEAT", stmt.span)
+        until = self._expr(stmt.conditions[0])
+        self.out.append(ir.Repeat(body=body, until=until, span=stmt.span))
+
+    def _loop(self, stmt: Block) -> None:
+        body = self._loop_body(stmt.bodies[0], "LOOP", stmt.span)
+        self.out.append(ir.Loop(body=body, span=stmt.span))
+
+    # ---- structured lowering: bodies, loops and joins
+    def _child(self, loop: bool = False, probe: bool = False) -> _Lowering:
+        """A lowering of a nested body, from the state here. A probe reports nothing."""
+        child = _Lowering(self.ctx, self.state, self.variables.copy())
+        child.track = dataclasses.replace(self.track)
+        child.call_stack = list(self.call_stack)
+        child.loop_depth = self.loop_depth + (1 if loop else 0)
+        child.loops = [*self.loops, "block"] if loop else list(self.loops)
+        child.ambiguous = dict(self.ambiguous)
+        child.routine = self.routine
+        child.in_block = self.in_block + 1
+        if not probe:
+            child.ignored, child.notes, child.status_turn = (
+                self.ignored,
+                self.notes,
+                self.status_turn,
+            )
+            child._reported = self._reported
+        return child
+
+    def _branch(self, body: Sequence[Stmt], loop: bool = False) -> tuple[_Lowering, Body]:
+        child = self._child(loop)
+        child.lower_body(body)
+        return child, build_instructions(child.out)
+
+    def _loop_body(self, body: Sequence[Stmt], keyword: str, span: ir.SourceSpan) -> Body:
+        """A loop's body, lowered once from the state every pass may start with: variables it
+        assigns are unknown, motion settings it changes are ambiguous and the position it changes
+        is unknown from the loop's start on (one pass of the data-flow reaches the fixpoint:
+        "changed by the body" does not grow on a second pass)."""
+        probe = self._child(loop=True, probe=True)
+        probe.lower_body(body)
+        where = f"the {keyword} at line {span.line}"
+        for name in sorted(probe.variables.changed_since(self.variables)):
+            self.variables.assign(name, Unknown(f"{name} may be changed by a pass of {where}"))
+        self._merge_states([self, probe], where)
+        child, lowered = self._branch(body, loop=True)
+        self._join([child], keyword, span, fallthrough=True)
+        return lowered
+
+    def _join(
+        self,
+        children: Sequence[_Lowering],
+        keyword: str,
+        span: ir.SourceSpan,
+        fallthrough: bool = False,
+    ) -> None:
+        """After a block: what every path reaching its end agrees on is known, the rest is not.
+        ``fallthrough``: the block may be skipped (a loop not entered)."""
+        reached = [
+            c for c in children if c.returned is None and c.exiting is None and c.jumped is None
+        ]
+        reached += [self] if fallthrough else []
+        where = f"the {keyword} at line {span.line}"
+        if not reached:
+            reached = list(children)
+        base = self.variables
+        changed = set().union(*(c.variables.changed_since(base) for c in reached if c is not self))
+        for name in sorted(changed):
+            values = [c.variables.lookup(name) for c in reached]
+            if all(v is values[0] or v == values[0] for v in values):
+                self.variables.assign(name, values[0])
+            else:
+                self.variables.assign(name, Unknown(f"{name} depends on the path through {where}"))
+        self._merge_states(reached, where)
+
+    def _merge_states(self, ends: Sequence[_Lowering], where: str) -> None:
+        """Motion settings and the position after paths ending in ``ends``."""
+        states = [e.state for e in ends]
+        ambiguous: dict[str, str] = {}
+        for e in ends:
+            ambiguous.update(e.ambiguous)
+        for name in _STATE_FIELDS:
+            values = [getattr(s, name) for s in states]
+            if any(v != values[0] for v in values[1:]):
+                ambiguous[name] = f"{_SETTING_NAMES[name]} differs between the paths of {where}"
+        vel_cp_set = all(s.vel_cp_set for s in states)
+        self.state = dataclasses.replace(states[0], vel_cp_set=vel_cp_set)
+        self.ambiguous = ambiguous
+        tracks = [e.track for e in ends]
+        if any(t != tracks[0] for t in tracks[1:]):
+            self.track = dataclasses.replace(tracks[0])
+            reason = f"the paths through {where} end at different positions"
+            self.track.lose_cartesian(reason)
+            self.track.joints, self.track.no_joints = None, reason
+        else:
+            self.track = dataclasses.replace(tracks[0])
+
+    def _expr(self, expr: Expr) -> ir.Expr:
+        converted = to_expr(expr, self._input_index)
+        assert converted is not None
+        return converted
+
+    def _input_index(self, var: Var) -> int | None:
+        if var.key == "$IN[]":
+            index = var.selectors[0]
+            assert isinstance(index, Index)
+            arg = index.args[0] if len(index.args) == 1 else None
+            return None if arg is None else as_int(self._value(arg))
+        if not var.selectors:
+            signal = self._value(var)
+            if isinstance(signal, Signal) and signal.io == "$IN":
+                return signal.index
+        return None
+
+    # ---- jumps
+    def _goto(self, stmt: Other) -> None:
+        name = (stmt.name or "").upper()
+        if name not in self.routine.labels:
+            raise self._error(f"GOTO {stmt.name}: no label {stmt.name} in this routine", stmt.span)
+        if name in self.routine.seen:  # a jump back: its state is known from the first pass
+            self.routine.back_states.setdefault(name, []).append(self.state)
+        else:
+            self.routine.pending.setdefault(name, []).append(self._snapshot())
+        self.out.append(ir.Goto(label=stmt.name or "", span=stmt.span))
+        self.jumped = stmt.span.line
+
+    def _label(self, stmt: Other) -> None:
+        name = (stmt.name or "").upper()
+        lines = self.routine.targets.get(name, [])
+        incoming = self.routine.pending.pop(name, [])
+        ends = ([] if self.jumped is not None else [self]) + incoming
+        self.jumped = None
+        if ends and (incoming or self not in ends):
+            self._merge_states(ends, f"the GOTOs to {stmt.name}")
+            self._join_variables(ends, f"the GOTOs to {stmt.name}")
+        if any(line > stmt.span.line for line in lines):  # jumped to from below: a loop
+            reason = f"{stmt.name} is jumped back to (GOTO at line {max(lines)})"
+            for back in self.routine.first_pass.get(name, []):
+                for field_name in _STATE_FIELDS:
+                    if getattr(back, field_name) != getattr(self.state, field_name):
+                        setting = _SETTING_NAMES[field_name]
+                        self.ambiguous[field_name] = f"{setting} differs where {reason}"
+            for var in sorted(self.routine.assigned):
+                self.variables.assign(var, Unknown(f"{var} may change before {reason}"))
+            self.track.lose_cartesian(reason)
+            self.track.joints, self.track.no_joints = None, reason
+        self.routine.seen[name] = self.state
+        self.out.append(ir.Label(name=stmt.name or "", span=stmt.span))
+
+    def first_pass(self, body: Sequence[Stmt]) -> None:
+        """Where the routine jumps back, lower it once quietly to learn the states of its
+        backward GOTOs (see :class:`RoutineJumps`)."""
+        if not self.routine.jumps_back:
+            return
+        probe = self._child(probe=True)
+        probe.in_block = self.in_block
+        probe.routine = RoutineJumps.of(body)
+        probe.lower_body(body)
+        self.routine.first_pass = probe.routine.back_states
+
+    def _snapshot(self) -> _Lowering:
+        snap = self._child(probe=True)
+        snap.in_block = self.in_block
+        return snap
+
+    def _join_variables(self, ends: Sequence[_Lowering], where: str) -> None:
+        changed = set().union(*(e.variables.changed_since(self.variables) for e in ends))
+        for name in sorted(changed):
+            values = [e.variables.lookup(name) for e in ends]
+            if not all(v is values[0] or v == values[0] for v in values):
+                self.variables.assign(name, Unknown(f"{name} depends on the path through {where}"))
 
     def _other(self, stmt: Other) -> None:
         routine = self.call_stack[-1] if self.call_stack else "the program"
-        if stmt.kind == "RETURN":
+        if stmt.kind == "GOTO":
+            self._goto(stmt)
+        elif stmt.kind == "label":
+            self._label(stmt)
+        elif stmt.kind == "RETURN" and self.in_block:
+            if self.call_stack:
+                raise self._error(
+                    f"RETURN inside a block of {routine}: olp inlines calls and cannot inline a "
+                    "routine that returns from inside a block",
+                    stmt.span,
+                )
+            self.out.append(ir.Return(span=stmt.span))
+            self.returned = (routine, stmt.span.line)
+        elif stmt.kind == "RETURN":
             self.returned = (routine, stmt.span.line)
             where = "ends the program" if not self.call_stack else f"returns from {routine}"
             self._ignore(stmt, f"RETURN {where} here")
-        elif stmt.kind == "GOTO":
-            raise self._error("GOTO is not supported (olp's IR has no control flow)", stmt.span)
+        elif stmt.kind == "EXIT" and self.loops and self.loops[-1] == "block":
+            self.out.append(ir.Exit(span=stmt.span))
+            self.exiting = stmt.span.line
         elif stmt.kind == "EXIT" and self.loop_depth > 0:
             self.exiting = stmt.span.line
+        elif stmt.kind in _KEPT_OTHERS:
+            self._keep(stmt, OTHER_REASONS[stmt.kind])
         else:
             self._ignore(stmt, OTHER_REASONS[stmt.kind])
+
+
+Body = tuple[ir.Node, ...]
+_STATE_FIELDS = (
+    "speed",
+    "vel_axis",
+    "acc_axis",
+    "cdis_mm",
+    "tool",
+    "frame",
+    "ori_type",
+    "circ_type",
+)
+_SETTING_NAMES = {
+    "speed": "the speed",
+    "vel_axis": "$VEL_AXIS",
+    "acc_axis": "$ACC_AXIS",
+    "cdis_mm": "$APO.CDIS",
+    "tool": "$TOOL",
+    "frame": "$BASE",
+    "ori_type": "$ORI_TYPE",
+    "circ_type": "$CIRC_TYPE",
+}
 
 
 # ------------------------------------------------------------------------------------------------
@@ -363,7 +702,10 @@ def lower_module(
 ) -> KrlResult:
     """Lower the first DEF of ``module``; the other routines are inlined where called."""
     routines = _routines(module, sources, src)
-    main = routines[0]
+    if not any(r.kind == "DEF" for r in routines):
+        return _functions_only(routines, sources, src, dat, config)
+    main = next(r for r in routines if r.kind == "DEF")
+    routines = [main, *(r for r in routines if r is not main)]
     table = {r.name.upper(): r for r in routines}
     ctx = Context(sources, table, src, dat, config, MAX_LOWERED_STATEMENTS)
     data = [d for d in (config, dat) if d is not None]
@@ -378,7 +720,9 @@ def lower_module(
         }
     )
     lowering = _Lowering(ctx, State(), variables)
+    lowering.routine = RoutineJumps.of(main.body)
     ctx.called.add(main.name.upper())
+    lowering.first_pass(main.body)
     lowering.lower_body(main.body)
     for other in routines[1:]:
         if other.name.upper() not in ctx.called:
@@ -411,13 +755,39 @@ def _routines(module: Module, sources: SourceSet, src: str) -> list[Routine]:
         source = sources.source(src)
         line, column = source.last_position() if source is not None else (1, 1)
         raise sources.error("no DEF ... END routine found", ir.SourceSpan(src, line, column))
-    if routines[0].kind != "DEF":
-        raise sources.error(
-            f"the first routine must be a DEF, found {routines[0].kind}", routines[0].span
-        )
     seen: set[str] = set()
     for routine in routines:
         if routine.name.upper() in seen:
             raise sources.error(f"{routine.kind} {routine.name} is defined twice", routine.span)
         seen.add(routine.name.upper())
     return routines
+
+
+def _functions_only(
+    routines: list[Routine],
+    sources: SourceSet,
+    src: str,
+    dat: KrlData | None,
+    config: KrlData | None,
+) -> KrlResult:
+    """A module of functions only (a library of DEFFCTs, called from other modules): there is no
+    program to run, so the program is empty and every function is reported as not lowered."""
+    names = ", ".join(r.name for r in routines)
+    ignored = [
+        IgnoredLine(
+            r.span,
+            sources.snippet(r.span),
+            f"the module holds only functions ({names}) and no DEF to run; olp does not lower "
+            "functions yet",
+        )
+        for r in routines
+    ]
+    for data_list in (dat, config):
+        ignored.extend(data_list.ignored if data_list is not None else ())
+    name = os.path.splitext(os.path.basename(src))[0] or routines[0].name
+    data = [d for d in (config, dat) if d is not None]
+    return KrlResult(
+        program=ir.Program(name=name, instructions=(), source=src),
+        ignored=tuple(ignored),
+        data_sources=tuple(d.filename for d in data),
+    )

@@ -47,8 +47,11 @@ _BASE_MOTION = {
     "CIRC": "CIRC",
     "SCIRC": "CIRC",
     "CIRC_REL": "CIRC",
+    "SPTP_REL": "PTP",
+    "SLIN_REL": "LIN",
+    "SCIRC_REL": "CIRC",
 }
-_SPLINE_MOTIONS = frozenset({"SPTP", "SLIN", "SCIRC"})
+_SPLINE_MOTIONS = frozenset({"SPTP", "SLIN", "SCIRC", "SPTP_REL", "SLIN_REL", "SCIRC_REL"})
 _CP_APPROX = ("C_DIS", "C_VEL", "C_ORI")
 _ONE_CP_APPROX = frozenset((a,) for a in _CP_APPROX)
 _FAST_KEYWORDS = {"PTP": "PTP", "SPTP": "PTP", "LIN": "LIN", "SLIN": "LIN"}

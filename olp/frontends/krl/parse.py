@@ -90,6 +90,8 @@ _OTHER_KINDS = {
     "exit_stmt": "EXIT",
     "continue_stmt": "CONTINUE",
     "brake_stmt": "BRAKE",
+    "resume_stmt": "RESUME",
+    "on_error_stmt": "ON_ERROR_PROCEED",
 }
 
 
@@ -110,13 +112,41 @@ class _With:
 _NOT_TARGETS = (_CircAngle, _With, Token)
 
 
-class _ToAst(Transformer[Token, Module]):
-    """Builds the AST; never raises for any tree the grammar accepts."""
+class _Case:
+    __slots__ = ("body", "values")
 
-    def __init__(self, filename: str, runs: dict[int, tuple[FastMotion, ...]]) -> None:
+    def __init__(self, values: tuple[Expr, ...], body: tuple[Stmt, ...]) -> None:
+        self.values, self.body = values, body
+
+
+class _Default:
+    __slots__ = ("body",)
+
+    def __init__(self, body: tuple[Stmt, ...]) -> None:
+        self.body = body
+
+
+DECL_FREE_TYPES = frozenset({"FRAME", "POS", "E6POS", "AXIS", "E6AXIS", "LOAD"})
+"""Structure types a declaration may name without DECL, as controllers' own files do
+(``E6AXIS XHOME={...}``, ``FRAME TOOL_CORR={...}``, ``LOAD LOAD_A1_DATA={...}`` in
+``$config.dat``; ``FRAME lfOffset`` in programs). Seen in public KR C4 backups; the KSS manual's
+exact rule is not quoted here, so olp accepts only these (and the simple types)."""
+
+
+class _ToAst(Transformer[Token, Module]):
+    """Builds the AST; never raises for any tree the grammar accepts, except for a declaration
+    without DECL of a type that may not be declared so (:data:`DECL_FREE_TYPES`)."""
+
+    def __init__(
+        self, filename: str, runs: dict[int, tuple[FastMotion, ...]], lines: Sequence[str] = ()
+    ) -> None:
         super().__init__(visit_tokens=True)
         self._filename = filename
         self._runs = runs
+        self._lines = lines
+
+    def _source_line(self, number: int) -> str | None:
+        return self._lines[number - 1] if 1 <= number <= len(self._lines) else None
 
     def _span(self, meta: Meta) -> ir.SourceSpan:
         return ir.SourceSpan(self._filename, meta.line, meta.column, meta.end_line, meta.end_column)
@@ -170,7 +200,7 @@ class _ToAst(Transformer[Token, Module]):
 
     @_inline
     def function(
-        self, meta: Meta, _global: Any, _type: Any, name: Token, params: Any, body: Any
+        self, meta: Meta, _global: Any, _type: Any, _dims: Any, name: Token, params: Any, body: Any
     ) -> Routine:
         return Routine("DEFFCT", str(name), params or (), body, self._span(meta))
 
@@ -178,8 +208,10 @@ class _ToAst(Transformer[Token, Module]):
         return tuple(children)
 
     @_inline
-    def param(self, meta: Meta, name: Token, direction: Token | None) -> Param:
-        return Param(str(name), None if direction is None else str(direction).upper())
+    def param(self, meta: Meta, name: Token, array: Token | None, direction: Token | None) -> Param:
+        return Param(
+            str(name), None if direction is None else str(direction).upper(), array is not None
+        )
 
     @_inline
     def dat_block(self, meta: Meta, name: Token, _public: Any, body: tuple[Stmt, ...]) -> DatBlock:
@@ -260,6 +292,25 @@ class _ToAst(Transformer[Token, Module]):
         return Decl(type_name.upper(), items, self._span(meta))
 
     @_inline
+    def bare_decl(self, meta: Meta, *children: Any) -> Decl:
+        """A declaration without DECL (``FRAME lfOffset``): the type is the name before the
+        first item, after any GLOBAL/CONST. Only the predefined structure types may be declared
+        so (:data:`DECL_FREE_TYPES`); anything else is a located error, so that a misspelt
+        statement (``PTPP XP1``) is never taken for a declaration."""
+        items = tuple(c for c in children if isinstance(c, DeclItem))
+        type_name = next(c for c in children if isinstance(c, Token) and c.type == "NAME")
+        if type_name.upper() not in DECL_FREE_TYPES:
+            first = items[0]
+            known = ", ".join(sorted(DECL_FREE_TYPES))
+            raise ParseError(
+                f"unexpected {first.name!r} after {str(type_name)!r}: {type_name} is not a "
+                f"statement, and only the predefined types ({known}) are declared without DECL",
+                first.span,
+                self._source_line(first.span.line),
+            )
+        return Decl(str(type_name).upper(), items, self._span(meta))
+
+    @_inline
     def type_name(self, meta: Meta, name: Any) -> str:
         return str(name)
 
@@ -286,8 +337,9 @@ class _ToAst(Transformer[Token, Module]):
         return Block(keyword, kept, self._span(meta))
 
     @_inline
-    def if_stmt(self, meta: Meta, _cond: Expr, then: Any, otherwise: Any) -> Block:
-        return self._block("IF", meta, (then, otherwise))
+    def if_stmt(self, meta: Meta, cond: Expr, then: Any, otherwise: Any) -> Block:
+        bodies = (then or (), otherwise or ())
+        return Block("IF", bodies, self._span(meta), (cond,), (), otherwise is not None)
 
     @_inline
     def for_stmt(
@@ -296,28 +348,40 @@ class _ToAst(Transformer[Token, Module]):
         return ForLoop(str(counter), start, end, step, body, self._span(meta))
 
     @_inline
-    def while_stmt(self, meta: Meta, _cond: Expr, body: Any) -> Block:
-        return self._block("WHILE", meta, (body,))
+    def while_stmt(self, meta: Meta, cond: Expr, body: Any) -> Block:
+        return Block("WHILE", (body or (),), self._span(meta), (cond,))
 
     @_inline
     def loop_stmt(self, meta: Meta, body: Any) -> Block:
         return self._block("LOOP", meta, (body,))
 
     @_inline
-    def repeat_stmt(self, meta: Meta, body: Any, _cond: Expr) -> Block:
-        return self._block("REPEAT", meta, (body,))
+    def repeat_stmt(self, meta: Meta, body: Any, until: Expr) -> Block:
+        return Block("REPEAT", (body or (),), self._span(meta), (until,))
 
     @_inline
-    def switch_stmt(self, meta: Meta, _subject: Expr, *clauses: Any) -> Block:
-        return self._block("SWITCH", meta, clauses)
+    def switch_stmt(self, meta: Meta, subject: Expr, *clauses: Any) -> Block:
+        cases = [c for c in clauses if isinstance(c, _Case)]
+        default = next((c for c in clauses if isinstance(c, _Default)), None)
+        bodies = (*(c.body for c in cases), () if default is None else default.body)
+        values = tuple(c.values for c in cases)
+        return Block("SWITCH", bodies, self._span(meta), (subject,), values, default is not None)
 
     @_inline
-    def case_clause(self, meta: Meta, _values: Any, body: tuple[Stmt, ...]) -> tuple[Stmt, ...]:
-        return body
+    def case_clause(self, meta: Meta, values: tuple[Expr, ...], body: Any) -> _Case:
+        return _Case(values, body or ())
 
     @_inline
-    def default_clause(self, meta: Meta, body: tuple[Stmt, ...]) -> tuple[Stmt, ...]:
-        return body
+    def default_clause(self, meta: Meta, body: Any) -> _Default:
+        return _Default(body or ())
+
+    @_inline
+    def goto_stmt(self, meta: Meta, name: Token) -> Other:
+        return Other("GOTO", self._span(meta), str(name))
+
+    @_inline
+    def label(self, meta: Meta, name: Token) -> Other:
+        return Other("label", self._span(meta), str(name))
 
     # ---- expressions
     @_inline
@@ -438,7 +502,7 @@ def parse_module(source: Source, fast: bool = True) -> Module:
 
 def _parse(text: str, filename: str, runs: dict[int, tuple[FastMotion, ...]], fast: bool) -> Module:
     tree = _parser(fast).parse(text + "\n")
-    return _ToAst(filename, runs).transform(tree)
+    return _ToAst(filename, runs, text.split("\n")).transform(tree)
 
 
 def _substitute_fast_runs(source: Source) -> tuple[str, dict[int, tuple[FastMotion, ...]]]:

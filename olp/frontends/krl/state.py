@@ -27,8 +27,10 @@ from olp.errors import ParseError
 from olp.frontends.krl.ast import (
     Aggregate,
     Assign,
+    Binary,
     EnumValue,
     Expr,
+    FuncCall,
     IgnoredLine,
     Index,
     Note,
@@ -36,6 +38,7 @@ from olp.frontends.krl.ast import (
     SourceSet,
     StatusTurn,
     Stmt,
+    Unary,
     Var,
 )
 from olp.frontends.krl.data import DataOps, KrlData, text_value
@@ -172,6 +175,48 @@ SYSTEM_REASONS = {
     "$COLLMON_TOL_PRO[]": "collision-detection tolerances are not modelled",
 }
 """Why a system variable olp knows but does not lower is ignored (keys as :attr:`Var.key`)."""
+KEPT_SYSTEM_VARIABLES = frozenset(
+    {
+        "$ACC.CP",
+        "$ACC",
+        "$ACC.ORI1",
+        "$ACC.ORI2",
+        "$VEL.ORI1",
+        "$VEL.ORI2",
+        "$APO.CPTP",
+        "$APO.CORI",
+        "$APO.CVEL",
+        "$ADVANCE",
+        "$LOAD",
+        "$GEAR_JERK[]",
+        "$JERK",
+    }
+)
+"""Motion parameters olp does not model yet but must not lose: kept as :class:`~olp.ir.Verbatim`
+(timing does not use them; the KRL post writes them back)."""
+SYSTEM_REASONS = {
+    **SYSTEM_REASONS,
+    "$ACC.ORI1": "orientation acceleration ($ACC.ORI1) is not part of olp's IR",
+    "$ACC.ORI2": "orientation acceleration ($ACC.ORI2) is not part of olp's IR",
+    "$VEL.ORI1": "orientation speed ($VEL.ORI1) is not lowered",
+    "$VEL.ORI2": "orientation speed ($VEL.ORI2) is not lowered",
+}
+
+
+INLINE_FORM_DATA = frozenset({"PDAT_ACT", "LDAT_ACT", "FDAT_ACT"})
+"""What the pendant's inline forms assign for BAS to read: absorbed into the motions' speeds,
+zones, tools and bases (:mod:`olp.frontends.krl.inline`), not kept as assignments."""
+
+
+def calls_function(expr: Expr) -> bool:
+    """Whether ``expr`` calls a function anywhere (a call may have effects: RSI_ON(...))."""
+    if isinstance(expr, FuncCall):
+        return True
+    if isinstance(expr, Binary):
+        return calls_function(expr.left) or calls_function(expr.right)
+    if isinstance(expr, Unary):
+        return calls_function(expr.operand)
+    return False
 
 
 # ------------------------------------------------------------------------------------------------
@@ -260,7 +305,7 @@ class Core:
         self.variables = variables
         self.evaluator = Evaluator(variables, ctx.sources.snippet)
         self.data = DataOps(variables, self.evaluator, ctx.sources)
-        self.out: list[ir.Instruction | Pending] = []
+        self.out: list[ir.Node | Pending] = []
         self.ignored: list[IgnoredLine] = []
         self.notes: list[Note] = []
         self.status_turn: list[StatusTurn] = []
@@ -295,6 +340,20 @@ class Core:
         if key not in self._reported:
             self._reported.add(key)
             self.ignored.append(IgnoredLine(stmt.span, self.sources.snippet(stmt.span), reason))
+
+    def _assignment(self, stmt: Assign) -> ir.Assign:
+        """``stmt`` as IR: a statement of the program, kept whatever olp knows of its value."""
+        from olp.frontends.krl.flow import to_expr
+
+        target, value = (to_expr(e, lambda _: None) for e in (stmt.target, stmt.value))
+        assert target is not None and value is not None
+        return ir.Assign(target=target, value=value, span=stmt.span)
+
+    def _keep(self, stmt: Stmt | Assign, reason: str) -> None:
+        """Keep a statement olp does not model as :class:`~olp.ir.Verbatim` (its text without
+        the comment): the KRL post writes it back, other posts stop on it."""
+        text = self.sources.snippet(stmt.span).split(";", 1)[0].strip()
+        self.out.append(ir.Verbatim(text=text, language="krl", reason=reason, span=stmt.span))
 
     def _note(self, span: ir.SourceSpan, message: str, once: str | None = None) -> None:
         key = ("note", once) if once is not None else ("note", span, message)
@@ -358,15 +417,17 @@ class Core:
         setter = self._setters.get(key)
         if setter is not None:
             setter(key, stmt.value, stmt)
+        elif key in KEPT_SYSTEM_VARIABLES:
+            self._keep(stmt, SYSTEM_REASONS[key])
         elif key.startswith("$"):
             generic = f"system variable {key.split('[')[0]} is not lowered yet"
             self._ignore(stmt, SYSTEM_REASONS.get(key, generic))
         elif self._is_signal(stmt.target):
             self._signal_output(stmt)
         else:
-            reason = self.data.assign(stmt)
-            if reason is not None:
-                self._ignore(stmt, reason)
+            self.data.assign(stmt)  # what olp knows of the value afterwards
+            if stmt.target.name.upper() not in INLINE_FORM_DATA:
+                self.out.append(self._assignment(stmt))
 
     def _set_vel_cp(self, name: str, value: Expr, stmt: Stmt) -> None:
         self._vel_cp(self._number(value, "$VEL.CP (m/s)"), value.span)
@@ -407,7 +468,9 @@ class Core:
         self.state = dataclasses.replace(self.state, cdis_mm=distance)
 
     def _set_struct(self, name: str, value: Expr, stmt: Stmt) -> None:
-        """``$VEL = {CP 0.5, ...}``: each component as its own assignment."""
+        """``$VEL = {CP 0.5, ...}``: each component as its own assignment; a motion parameter
+        olp keeps (:data:`KEPT_SYSTEM_VARIABLES`, e.g. ``$ACC = {CP 2, ORI1 200, ORI2 200}``)
+        with components olp does not model is also kept as written, so none is lost."""
         if not isinstance(value, Aggregate):
             raise self._error(f"{name} must be set from an aggregate {{...}} here", value.span)
         unused = []
@@ -420,7 +483,10 @@ class Core:
                 setter(component, member.value, stmt)
         if unused:
             listed = ", ".join(unused)
-            self._ignore(stmt, f"{name} component(s) {listed} not lowered yet")
+            if name in KEPT_SYSTEM_VARIABLES:
+                self._keep(stmt, f"{name} component(s) {listed} not modelled: kept as written")
+            else:
+                self._ignore(stmt, f"{name} component(s) {listed} not lowered yet")
 
     def _set_axis_percent(self, key: str, value: Expr, stmt: Stmt) -> None:
         assert isinstance(stmt, Assign)
@@ -615,7 +681,7 @@ def element_span(element: Value, default: ir.SourceSpan) -> ir.SourceSpan:
     return span if isinstance(span, ir.SourceSpan) else default
 
 
-def build_instructions(out: Sequence[ir.Instruction | Pending]) -> tuple[ir.Instruction, ...]:
+def build_instructions(out: Sequence[ir.Node | Pending]) -> tuple[ir.Node, ...]:
     """The instructions, with all Cartesian poses computed in one vectorised call."""
     values = []
     for item in out:
@@ -625,7 +691,7 @@ def build_instructions(out: Sequence[ir.Instruction | Pending]) -> tuple[ir.Inst
             if item.via is not None:
                 values.append(item.via.values)
     poses = iter(frame_to_pose(np.array(values, dtype=np.float64).reshape(-1, 6)))
-    built: list[ir.Instruction] = []
+    built: list[ir.Node] = []
     for item in out:
         if not isinstance(item, Pending):
             built.append(item)

@@ -26,7 +26,7 @@ from olp.ir import is_motion
 from olp.passes.timing import jerk, ptp, ptp_blend, ur
 from olp.passes.timing.chains import PATH_SOLVERS, path_problem, time_law
 from olp.passes.timing.geometry import joined_geometry
-from olp.passes.timing.lines import line_profiles, straight_samples
+from olp.passes.timing.lines import LineProfiles, line_profiles, straight_samples
 from olp.passes.timing.plan import (
     MIN_PATH_SPEED,
     TimingError,
@@ -59,6 +59,7 @@ from olp.trajectory import (
 
 if TYPE_CHECKING:
     from olp.passes.pipeline import BuildOptions
+    from olp.station.model import Robot
 
 
 FloatArray = NDArray[np.float64]
@@ -250,16 +251,18 @@ def time_lines(
     q0, q1 = table.q[table.lo[rows]], table.q[table.hi[rows]]
     robot = table.compiled.station.robot
     tools = table.tools[table.tool[rows]]
-    profiles = line_profiles(
+    profiles = _line_profiles(
         q0,
         q1,
         robot,
         tools,
-        table.linear[rows],
-        table.angular[rows],
-        table.linear_acceleration[rows],
-        table.angular_acceleration[rows],
-        jerk=options.path_jerk,
+        (
+            table.linear[rows],
+            table.angular[rows],
+            table.linear_acceleration[rows],
+            table.angular_acceleration[rows],
+        ),
+        options.path_jerk,
     )
     ok = profiles.excess <= options.line_tolerance
     rows = rows[ok]
@@ -280,6 +283,49 @@ def time_lines(
     timed = np.zeros(straight.size, dtype=bool)
     timed[np.flatnonzero(straight)[ok]] = True
     return timed
+
+
+LINE_ROWS = 1 << 14
+"""Moves per batch of :func:`line_profiles` (five forward kinematics each: about 10 kB of
+temporaries per move, so a batch holds ~160 MB at most; all moves of a 100k toolpath at once
+took 330 MB)."""
+
+
+def _line_profiles(
+    q0: FloatArray,
+    q1: FloatArray,
+    robot: Robot,
+    tools: FloatArray,
+    limits: tuple[FloatArray, FloatArray, FloatArray, FloatArray],
+    jerk: bool,
+) -> LineProfiles:
+    """:func:`line_profiles` in batches of :data:`LINE_ROWS` moves; ``limits``: the TCP's
+    linear and angular speeds and accelerations (M,) each."""
+
+    linear, angular, linear_accel, angular_accel = limits
+
+    def batch(part: slice) -> LineProfiles:
+        return line_profiles(
+            q0[part],
+            q1[part],
+            robot,
+            tools[part],
+            linear[part],
+            angular[part],
+            linear_accel[part],
+            angular_accel[part],
+            jerk=jerk,
+        )
+
+    parts = [batch(slice(lo, lo + LINE_ROWS)) for lo in range(0, len(q0), LINE_ROWS)]
+    if not parts:
+        return batch(slice(0, 0))
+    return LineProfiles(
+        *(
+            np.concatenate([getattr(p, f) for p in parts])
+            for f in ("accel", "ramp", "duration", "excess", "jerk_time")
+        )
+    )
 
 
 def time_chains(
@@ -471,7 +517,7 @@ def zone_stops(
     found = []
     for i in np.flatnonzero(stops).tolist():
         msg = (
-            f"zone of {table.zone[i] * 1000:g} mm timed as an exact stop "
+            f"zone of {float(table.zone[i]) * 1000:g} mm timed as an exact stop "
             f"({_STOP_REASON[KIND_NAMES[int(table.kind[i])]]}): the cycle time is an upper "
             "bound here"
         )

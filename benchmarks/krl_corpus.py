@@ -1,0 +1,247 @@
+"""olp over a folder of KRL programs, as a new user would run it: what builds and what stops why.
+
+Run from the repository root::
+
+    python -m benchmarks.krl_corpus [FOLDER] [--station S] [--config-dat P] [--post P] [-v]
+
+FOLDER defaults to olp's own corpus ``tests/corpus/krc`` (programs written for olp in the style
+of KR C4 controller backups); point it at a backup's ``KRC`` folder to measure real cells. The
+controller's ``$config.dat`` is found in FOLDER (any case; the first in sorted order) unless
+``--config-dat`` names one. Every ``.src`` (any case) is built with ``olp.build`` on the station
+(default: the bundled KR 6 milling cell) through the post (default ``kuka``), collisions off
+(they are a property of the cell, not of the program's syntax), nothing written.
+
+Each file lands in one class:
+
+* ``build``: no error diagnostic;
+* ``program``: stopped on program-level diagnostics only (unreachable, limits, ...);
+* ``syntax``: stopped on an :class:`olp.errors.OlpError` (olp cannot read or lower something),
+  counted by construct (the keyword at the error, or the block it sits in);
+* ``post``: read, but the post cannot write something the program says (control flow, a line
+  kept verbatim for another language), counted by the post's diagnostic kind;
+* ``crash``: any other exception (a bug in olp).
+
+Besides, it counts statements of the ``.src`` olp read but did not put in the output and
+reported only at ``info`` level (``silent_drops``: "nothing dropped silently" wants 0), and, for
+the files that build, where each statement of the ``.src`` went: ``kept`` (a node of the
+program's IR carries its line, so the KRL post writes it), ``absorbed`` into the motions' speeds,
+zones, tools and bases (inline-form data, BAS, ``$VEL``/``$TOOL``/``$BASE``/``$APO``), an
+``inlined`` call of the module's own DEF, ``warned`` (reported as not in the output), or
+``unaccounted`` (the figure that must be 0: listed).
+
+The last lines are ``name: value unit``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+import re
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+CORPUS = REPO / "tests" / "corpus" / "krc"
+STATION = REPO / "stations" / "kr6_milling_cell.yaml"
+
+_KEYWORD_TEXT = (
+    "IF ELSE SWITCH CASE DEFAULT WHILE REPEAT UNTIL LOOP FOR GOTO EXIT HALT RETURN RESUME BRAKE "
+    "INTERRUPT TRIGGER DEFFCT DEF DECL STRUC ENUM SIGNAL EXT EXTFCT WAIT PTP LIN CIRC SPTP SLIN "
+    "SCIRC PTP_REL LIN_REL SPTP_REL SLIN_REL SCIRC_REL SPLINE ON_ERROR_PROCEED CONTINUE GLOBAL "
+    "CONST FRAME E6AXIS E6POS POS AXIS INT REAL BOOL CHAR"
+)
+_KEYWORDS = frozenset(_KEYWORD_TEXT.split())
+POST_KINDS = frozenset({"control_flow", "verbatim", "unsupported"})
+"""Errors of a post that cannot write what the program says: not the program's fault."""
+_INSIDE = re.compile(r"inside the (\w+) at line")
+_WORD = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]*")
+
+
+@dataclass
+class Tally:
+    """Counts over the corpus."""
+
+    classes: collections.Counter[str] = field(default_factory=collections.Counter)
+    constructs: collections.Counter[str] = field(default_factory=collections.Counter)
+    crashes: list[str] = field(default_factory=list)
+    silent_drops: int = 0
+    warned_drops: int = 0
+    statements_in: int = 0
+    kept: int = 0
+    absorbed: int = 0
+    inlined: int = 0
+    warned: int = 0
+    unaccounted: list[str] = field(default_factory=list)
+
+
+def construct_of(message: str, source_line: str | None) -> str:
+    """The construct an :class:`~olp.errors.OlpError` stopped on: the block a statement sits in,
+    else the first keyword of the offending line, else the message's first words."""
+    inside = _INSIDE.search(message)
+    if inside:
+        return inside.group(1).upper()
+    words = _WORD.findall(source_line or "")
+    for word in words[:3]:
+        if word.upper() in _KEYWORDS:
+            return word.upper()
+    if words and "=" in (source_line or ""):
+        return "assignment " + words[0].upper()
+    return "other: " + " ".join(message.split()[:5])
+
+
+_STRUCTURE = re.compile(
+    r"(?i)((GLOBAL\s+)?(DEF|DEFFCT)|END|ENDFCT|ELSE|ENDIF|ENDWHILE|ENDLOOP|ENDFOR|ENDSWITCH|CASE|"
+    r"DEFAULT|UNTIL)\b"
+)
+_ABSORBED = re.compile(
+    r"(?i)(BAS\s*\(|(PDAT_ACT|LDAT_ACT|FDAT_ACT)\s*=|\$(VEL|VEL_AXIS|ACC_AXIS|APO|TOOL|BASE|H_POS|"
+    r"IPO_MODE)\b)"
+)
+_ROUTINE = re.compile(r"(?i)(GLOBAL\s+)?(DEF|DEFFCT)\b")
+_CALL = re.compile(r"\s*([A-Za-z_][A-Za-z0-9_]*)\s*\(")
+
+
+def statement_lines(text: str) -> dict[int, str]:
+    """Line number -> text of the lines that hold a statement (not blank, not only a comment,
+    not a header, not a line that only opens, divides or closes a routine or a block)."""
+    found = {}
+    for number, raw in enumerate(text.splitlines(), start=1):
+        line = raw.split(";", 1)[0].strip()
+        if line and not line.startswith("&") and not _STRUCTURE.match(line):
+            found[number] = line
+    return found
+
+
+def account(text: str, src: str, result: object, tally: Tally) -> None:
+    """Where every statement of the program went: kept (an IR node has its line), absorbed
+    into the motions (inline-form data, BAS, $VEL/$TOOL/... settings), an inlined call, a
+    warning, or unaccounted (lost without a word: the figure that must be 0)."""
+    from olp.ir_flow import leaves_and_blocks
+
+    program = result.compiled.program  # type: ignore[attr-defined]
+    lines = statement_lines(text)
+    kept = {n.span.line for n in leaves_and_blocks(program.instructions) if n.span.file == src}
+    warned = {
+        d.span.line
+        for d in result.diagnostics  # type: ignore[attr-defined]
+        if d.span is not None and d.span.file == src and d.severity in ("warning", "error")
+    }
+    routines = {
+        m.group(1).upper() for m in re.finditer(r"(?im)^\s*(?:GLOBAL\s+)?DEF\s+(\w+)", text)
+    }
+    starts = [n for n, raw in enumerate(text.splitlines(), start=1) if _ROUTINE.match(raw.strip())]
+    for number, line in lines.items():
+        head = max((n for n in starts if n <= number), default=0)
+        if head in warned:  # a routine olp does not write (never called, functions only)
+            warned.add(number)
+        call = _CALL.match(line)
+        tally.statements_in += 1
+        if number in kept:
+            tally.kept += 1
+        elif _ABSORBED.match(line):
+            tally.absorbed += 1
+        elif call is not None and call.group(1).upper() in routines:
+            tally.inlined += 1
+        elif number in warned:
+            tally.warned += 1
+        else:
+            tally.unaccounted.append(f"{src}:{number}: {line}")
+
+
+def find_config(folder: Path) -> Path | None:
+    found = sorted(p for p in folder.rglob("*") if p.name.lower() == "$config.dat")
+    return found[0] if found else None
+
+
+def run(folder: Path, station_path: Path, config: Path | None, post: str, verbose: bool) -> Tally:
+    import olp
+    from olp.errors import OlpError
+    from olp.frontends.bundled import KrlOptions
+    from olp.frontends.krl import load_config_dat
+
+    station = olp.load_station(station_path)
+    config_data = None
+    if config is not None:
+        try:
+            config_data = load_config_dat(config)
+        except OlpError as exc:
+            print(f"config-dat unreadable, built without it: {exc.message}", file=sys.stderr)
+            print(f"  {exc.span}: {(exc.source_line or '').strip()[:80]}", file=sys.stderr)
+    options = KrlOptions(config_dat=config_data)
+    tally = Tally()
+    for path in sorted(p for p in folder.rglob("*") if p.suffix.lower() == ".src"):
+        verdict = _one(olp, path, station, options, post, tally, OlpError)
+        tally.classes[verdict.split(":")[0]] += 1
+        if verbose:
+            print(f"{path.relative_to(folder)}: {verdict}")
+    return tally
+
+
+def _one(olp, path, station, options, post, tally, olp_error) -> str:  # type: ignore[no-untyped-def]
+    try:
+        result = olp.build(station, path, post=post, program_options=options, collisions=None)
+    except olp_error as exc:
+        construct = construct_of(exc.message, exc.source_line)
+        tally.constructs[construct] += 1
+        return f"syntax: {construct} ({exc.span})"
+    except Exception as exc:  # a crash is what this benchmark exists to find
+        tally.crashes.append(f"{path.name}: {type(exc).__name__}: {exc}")
+        return f"crash: {type(exc).__name__}"
+    src = str(path)  # data lists' lines (types, declarations) are not statements of the program
+    drops = [d for d in result.diagnostics if d.kind == "ignored" and d.span and d.span.file == src]
+    tally.silent_drops += sum(d.severity == "info" for d in drops)
+    tally.warned_drops += sum(d.severity != "info" for d in drops)
+    if not result.ok:
+        errors = [d for d in result.diagnostics if d.severity == "error"]
+        unwritable = [d for d in errors if d.kind in POST_KINDS]
+        if unwritable:
+            tally.constructs[f"post: {unwritable[0].kind}"] += 1
+            return f"post: {unwritable[0].kind}"
+        return f"program: {errors[0].kind}"
+    text = path.read_text(encoding="latin-1")
+    account(text, src, result, tally)
+    return "build"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("folder", nargs="?", type=Path, default=CORPUS)
+    parser.add_argument("--station", type=Path, default=STATION)
+    parser.add_argument("--config-dat", type=Path, default=None)
+    parser.add_argument("--post", default="kuka")
+    parser.add_argument("-v", "--verbose", action="store_true")
+    args = parser.parse_args()
+    config = args.config_dat or find_config(args.folder)
+    start = time.perf_counter()
+    tally = run(args.folder, args.station, config, args.post, args.verbose)
+    seconds = time.perf_counter() - start
+    total = sum(tally.classes.values())
+    for construct, count in tally.constructs.most_common():
+        print(f"  stops on {construct}: {count}")
+    for crash in tally.crashes:
+        print(f"  crash {crash}")
+    ok = tally.classes["build"] + tally.classes["program"]
+    print(f"files: {total} files")
+    print(f"build: {tally.classes['build']} files")
+    print(f"program: {tally.classes['program']} files")
+    print(f"syntax: {tally.classes['syntax']} files")
+    print(f"post: {tally.classes['post']} files")
+    print(f"crash: {tally.classes['crash']} files")
+    print(f"build_or_program: {100.0 * ok / max(total, 1):.1f} %")
+    print(f"silent_drops: {tally.silent_drops} statements")
+    print(f"warned_drops: {tally.warned_drops} statements")
+    for line in tally.unaccounted:
+        print(f"  unaccounted {line}")
+    print(f"statements_in: {tally.statements_in} statements")
+    print(f"statements_kept: {tally.kept} statements")
+    print(f"statements_absorbed: {tally.absorbed} statements")
+    print(f"statements_inlined_calls: {tally.inlined} statements")
+    print(f"statements_warned: {tally.warned} statements")
+    print(f"statements_unaccounted: {len(tally.unaccounted)} statements")
+    print(f"seconds: {seconds:.2f} s")
+
+
+if __name__ == "__main__":
+    main()

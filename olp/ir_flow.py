@@ -1,0 +1,442 @@
+"""The IR's statements beyond motion and I/O: what olp keeps but does not model.
+
+Re-exported from :mod:`olp.ir` (``from olp.ir import Verbatim``). Like every IR node these are
+frozen dataclasses with a ``span`` and a ``kind``, changed with ``dataclasses.replace``.
+
+:class:`Verbatim` is the one vendor-specific node of the IR, on purpose: a statement a frontend
+read, kept so that nothing is dropped, but whose meaning olp does not model (``$ACC.CP = 2.0``,
+``ret = RSI_ON(#RELATIVE)``). A post of the same ``language`` writes its text unchanged; any
+other post stops with an error naming the line. Passes treat it as taking no time and moving
+nothing (which is the approximation: the controller may do more).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING, Any, Literal, TypeAlias
+
+from olp.span import GENERATED, SourceSpan
+
+if TYPE_CHECKING:
+    from olp.ir import Node
+
+
+class FlowError(ValueError):
+    """A flow node was made with values it cannot hold (raised at construction)."""
+
+
+_LINE_BREAKS = frozenset("\n\r\x0b\x0c\x1c\x1d\x1e\x85\u2028\u2029")
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Verbatim:
+    """A statement kept as its source text: ``text`` (one line, as the source spells it, without
+    its comment), the ``language`` it is written in (a frontend's language, ``"krl"``), and
+    ``reason``: why olp does not model it.
+
+    The text can never become more than one statement of the output: it must be one line
+    without control characters (checked here, and again by the post that writes it).
+    """
+
+    text: str
+    language: str
+    reason: str = ""
+    span: SourceSpan = GENERATED
+    kind: Literal["verbatim"] = field(default="verbatim", init=False)
+
+    def __post_init__(self) -> None:
+        if not self.text.strip():
+            raise FlowError("Verbatim.text must hold a statement, got an empty text")
+        bad = next((c for c in self.text if c in _LINE_BREAKS or (ord(c) < 32 and c != "\t")), None)
+        if bad is not None:
+            raise FlowError(f"Verbatim.text must be one line, found {bad!r} in {self.text!r}")
+        if not self.language:
+            raise FlowError("Verbatim.language must name the language of the text")
+
+
+# --------------------------------------------------------------------------------------------
+# Expressions: what a condition, a bound or an assigned value says, vendor-neutral
+
+BINARY_OPERATORS = frozenset(
+    {
+        "+",
+        "-",
+        "*",
+        "/",
+        "==",
+        "<>",
+        "<",
+        "<=",
+        ">",
+        ">=",
+        "and",
+        "or",
+        "xor",
+        "bit_and",
+        "bit_or",
+        "bit_xor",
+        "geometric",
+    }
+)
+"""Operators of :class:`BinaryOp`. ``geometric`` is KUKA's ``:`` (frame composition); a post
+without it stops on it with a located error."""
+UNARY_OPERATORS = frozenset({"-", "+", "not", "bit_not"})
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Constant:
+    """A constant: ``bool``, ``int``, ``float`` or ``str``; ``enum``: the value names an
+    enumeration member (KRL ``#BASE``), written by its own language only."""
+
+    value: bool | int | float | str
+    enum: bool = False
+    span: SourceSpan = GENERATED
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Name:
+    """A variable (or constant) by name, as the program spells it."""
+
+    name: str
+    span: SourceSpan = GENERATED
+
+    def __post_init__(self) -> None:
+        if not self.name:
+            raise FlowError("Name.name must not be empty")
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Index:
+    """``base[indices]``; an index left out (KRL ``TEXT[]``, ``NAME[1,]``) is None."""
+
+    base: Expr
+    indices: tuple[Expr | None, ...]
+    span: SourceSpan = GENERATED
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Member:
+    """``base.field`` (a component of a structure: ``lPlace.Z``)."""
+
+    base: Expr
+    field: str
+    span: SourceSpan = GENERATED
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class DigitalInput:
+    """The state of digital input ``index`` (KRL ``$IN[n]``)."""
+
+    index: int
+    span: SourceSpan = GENERATED
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class FunctionCall:
+    """A call in an expression: ``name(args)``; an argument left out is None."""
+
+    name: str
+    args: tuple[Expr | None, ...] = ()
+    span: SourceSpan = GENERATED
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class BinaryOp:
+    op: str
+    left: Expr
+    right: Expr
+    span: SourceSpan = GENERATED
+
+    def __post_init__(self) -> None:
+        if self.op not in BINARY_OPERATORS:
+            raise FlowError(
+                f"BinaryOp.op must be one of {sorted(BINARY_OPERATORS)}, got {self.op!r}"
+            )
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class UnaryOp:
+    op: str
+    operand: Expr
+    span: SourceSpan = GENERATED
+
+    def __post_init__(self) -> None:
+        if self.op not in UNARY_OPERATORS:
+            raise FlowError(f"UnaryOp.op must be one of {sorted(UNARY_OPERATORS)}, got {self.op!r}")
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Aggregate:
+    """A structure value: ``{X 1, Y 2}`` as (member, value) pairs; ``type_name`` as written."""
+
+    members: tuple[tuple[str, Expr], ...]
+    type_name: str | None = None
+    span: SourceSpan = GENERATED
+
+
+Expr: TypeAlias = (
+    Constant | Name | Index | Member | DigitalInput | FunctionCall | BinaryOp | UnaryOp | Aggregate
+)
+
+
+# --------------------------------------------------------------------------------------------
+# Statements: data, waits, jumps
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Declare:
+    """Declare variable ``name`` of ``type_name`` (the language's type name: ``INT``, ``REAL``,
+    ``BOOL``, ``CHAR``, ``FRAME``, ``E6POS``, ``E6AXIS``, a structure's name) with array
+    ``dims`` (empty for a scalar), an optional initial ``value``; ``constant``: it never
+    changes; ``exported``: visible to other modules (KRL ``GLOBAL``)."""
+
+    name: str
+    type_name: str
+    dims: tuple[Expr | None, ...] = ()
+    value: Expr | None = None
+    constant: bool = False
+    exported: bool = False
+    span: SourceSpan = GENERATED
+    kind: Literal["declare"] = field(default="declare", init=False)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Assign:
+    """``target = value``; ``target`` is a :class:`Name`, :class:`Index` or :class:`Member`."""
+
+    target: Expr
+    value: Expr
+    span: SourceSpan = GENERATED
+    kind: Literal["assign"] = field(default="assign", init=False)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class WaitUntil:
+    """Wait until ``condition`` holds (KRL ``WAIT FOR``)."""
+
+    condition: Expr
+    span: SourceSpan = GENERATED
+    kind: Literal["wait_until"] = field(default="wait_until", init=False)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Label:
+    """A jump target."""
+
+    name: str
+    span: SourceSpan = GENERATED
+    kind: Literal["label"] = field(default="label", init=False)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Goto:
+    """Jump to :class:`Label` ``label`` of the same routine."""
+
+    label: str
+    span: SourceSpan = GENERATED
+    kind: Literal["goto"] = field(default="goto", init=False)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Exit:
+    """Leave the innermost loop."""
+
+    span: SourceSpan = GENERATED
+    kind: Literal["exit"] = field(default="exit", init=False)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Return:
+    """End the program here (olp inlines the routines it calls)."""
+
+    span: SourceSpan = GENERATED
+    kind: Literal["return"] = field(default="return", init=False)
+
+
+# --------------------------------------------------------------------------------------------
+# Blocks
+
+
+def _tuple(value: Any) -> tuple[Any, ...]:
+    return value if isinstance(value, tuple) else tuple(value)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Branch:
+    """One ``condition: body`` arm of an :class:`If`."""
+
+    condition: Expr
+    body: tuple[Node, ...]
+    span: SourceSpan = GENERATED
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "body", _tuple(self.body))
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class If:
+    """``if / else if ... / else``: the first ``branches`` arm whose condition holds runs, else
+    ``orelse``."""
+
+    branches: tuple[Branch, ...]
+    orelse: tuple[Node, ...] = ()
+    span: SourceSpan = GENERATED
+    kind: Literal["if"] = field(default="if", init=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "branches", _tuple(self.branches))
+        object.__setattr__(self, "orelse", _tuple(self.orelse))
+        if not self.branches:
+            raise FlowError("If needs at least one branch")
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Case:
+    """One arm of a :class:`Switch`: runs when the subject equals one of ``values``."""
+
+    values: tuple[Expr, ...]
+    body: tuple[Node, ...]
+    span: SourceSpan = GENERATED
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "values", _tuple(self.values))
+        object.__setattr__(self, "body", _tuple(self.body))
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Switch:
+    """``switch subject``: the first case with a matching value runs, else ``default``."""
+
+    subject: Expr
+    cases: tuple[Case, ...]
+    default: tuple[Node, ...] = ()
+    span: SourceSpan = GENERATED
+    kind: Literal["switch"] = field(default="switch", init=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "cases", _tuple(self.cases))
+        object.__setattr__(self, "default", _tuple(self.default))
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class While:
+    """Run ``body`` while ``condition`` holds (tested before each pass)."""
+
+    condition: Expr
+    body: tuple[Node, ...]
+    span: SourceSpan = GENERATED
+    kind: Literal["while"] = field(default="while", init=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "body", _tuple(self.body))
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Repeat:
+    """Run ``body``, then again until ``until`` holds (at least once)."""
+
+    body: tuple[Node, ...]
+    until: Expr
+    span: SourceSpan = GENERATED
+    kind: Literal["repeat"] = field(default="repeat", init=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "body", _tuple(self.body))
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Loop:
+    """Run ``body`` for ever; only an :class:`Exit` (or a jump, or :class:`Return`) leaves."""
+
+    body: tuple[Node, ...]
+    span: SourceSpan = GENERATED
+    kind: Literal["loop"] = field(default="loop", init=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "body", _tuple(self.body))
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class For:
+    """``for variable = start to stop [step step]`` (both bounds included)."""
+
+    variable: str
+    start: Expr
+    stop: Expr
+    body: tuple[Node, ...]
+    step: Expr | None = None
+    span: SourceSpan = GENERATED
+    kind: Literal["for"] = field(default="for", init=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "body", _tuple(self.body))
+
+
+Block: TypeAlias = If | Switch | While | Repeat | Loop | For
+Statement: TypeAlias = Declare | Assign | WaitUntil | Label | Goto | Exit | Return | Verbatim
+BLOCK_TYPES = (If, Switch, While, Repeat, Loop, For)
+FLOW_TYPES = (*BLOCK_TYPES, Declare, Assign, WaitUntil, Label, Goto, Exit, Return)
+"""Nodes of this module that are not ordinary instructions (:class:`Verbatim` is one: passes
+and posts treat it like any other instruction)."""
+
+
+# --------------------------------------------------------------------------------------------
+# Walking and editing
+
+
+def bodies(block: Block) -> tuple[tuple[Node, ...], ...]:
+    """The bodies of a block, in source order (an If's branches then its else)."""
+    if isinstance(block, If):
+        return (*(b.body for b in block.branches), block.orelse)
+    if isinstance(block, Switch):
+        return (*(c.body for c in block.cases), block.default)
+    return (block.body,)
+
+
+def with_bodies(block: Block, new: Sequence[tuple[Node, ...]]) -> Block:
+    """``block`` with its bodies replaced (same order as :func:`bodies`)."""
+    if isinstance(block, If):
+        arms = tuple(replace(b, body=body) for b, body in zip(block.branches, new, strict=False))
+        return replace(block, branches=arms, orelse=new[-1])
+    if isinstance(block, Switch):
+        cases = tuple(replace(c, body=body) for c, body in zip(block.cases, new, strict=False))
+        return replace(block, cases=cases, default=new[-1])
+    return replace(block, body=new[0])
+
+
+def leaves(nodes: Iterable[Any]) -> Iterator[Any]:
+    """Every node that is not a block, in source order, descending into blocks: the
+    instructions (and flow statements) as the program text lists them."""
+    for node in nodes:
+        if isinstance(node, BLOCK_TYPES):
+            for body in bodies(node):
+                yield from leaves(body)
+        else:
+            yield node
+
+
+def has_flow(nodes: Iterable[Any]) -> bool:
+    """Whether ``nodes`` hold any node of this module other than :class:`Verbatim`."""
+    return any(isinstance(n, FLOW_TYPES) for n in leaves_and_blocks(nodes))
+
+
+def leaves_and_blocks(nodes: Iterable[Any]) -> Iterator[Any]:
+    """Every node, blocks included (a block before its bodies' nodes)."""
+    for node in nodes:
+        yield node
+        if isinstance(node, BLOCK_TYPES):
+            for body in bodies(node):
+                yield from leaves_and_blocks(body)
+
+
+def map_leaves(nodes: Sequence[Any], edit: Callable[[Any], list[Any]]) -> tuple[Any, ...]:
+    """``nodes`` with every non-block node replaced by ``edit(node)`` (a list: empty deletes,
+    several insert), blocks kept with their bodies edited the same way."""
+    out: list[Any] = []
+    for node in nodes:
+        if isinstance(node, BLOCK_TYPES):
+            out.append(with_bodies(node, [map_leaves(b, edit) for b in bodies(node)]))
+        else:
+            out.extend(edit(node))
+    return tuple(out)

@@ -1,0 +1,138 @@
+"""Control flow for posts that write it (``Post.WRITES_FLOW``): the blocks of the program woven
+into a file's flat list of :class:`~olp.posts.view.PostStep`\\ s as marker steps.
+
+A template keeps walking one list, ``steps``; besides the instructions it meets markers whose
+``kind`` opens, divides or closes a block, with the block as ``instruction``:
+
+==========  ===========================================================
+``if``      ``instruction.branches[0].condition`` (olp's KRL lowering makes one branch;
+            further branches come as ``elif`` markers with ``instruction`` the branch)
+``else``    the If (only when it has an else body)
+``end_if``  the If
+``switch``  ``instruction.subject``; ``case`` markers carry the Case (``values``);
+            ``default`` (only when the default body is not empty); ``end_switch``
+``while``   ``instruction.condition``; ``end_while``
+``repeat``  ``until`` (``instruction.until``)
+``loop``    ``end_loop``
+``for``     ``instruction.variable``, ``start``, ``stop``, ``step``; ``end_for``
+==========  ===========================================================
+
+Declarations (kind ``declare``) are moved to the front, once per name (a routine inlined twice
+declares its variables twice), because languages such as KRL want them before any statement.
+
+Modal settings: a template writes ``$TOOL``, speeds and zones only when they change from the
+previous motion *in the text*; after a block boundary the previous motion in the text need not
+be the one that ran, so the first motion of each kind after any marker or label gets every
+``new_*`` flag set, and templates should forget their own trackers there
+(``modal.forget(...)``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Iterator, Sequence
+from typing import Any
+
+from olp import ir
+from olp.posts.view import PostStep
+
+_CLOSERS = {
+    ir.While: "end_while",
+    ir.Loop: "end_loop",
+    ir.For: "end_for",
+}
+
+
+def weave(program: ir.Program, steps: Sequence[PostStep]) -> list[PostStep]:
+    """``steps`` (one per instruction, in the order iterating ``program`` gives) with the
+    program's block markers woven in and the declarations first; see the module docstring."""
+    by_index = {s.index: s for s in steps}
+    body = list(_Weaver(by_index).nodes(program.instructions))
+    declared: dict[str, PostStep] = {}
+    for step in body:
+        if step.kind == "declare":
+            declared.setdefault(step.instruction.name.upper(), step)
+    rest = [s for s in body if s.kind != "declare"]
+    return [*declared.values(), *_fresh_after_boundaries(rest)]
+
+
+class _Weaver:
+    def __init__(self, by_index: dict[int, PostStep]) -> None:
+        self.by_index = by_index
+        self.cursor = 0
+
+    def nodes(self, nodes: Sequence[Any]) -> Iterator[PostStep]:
+        for node in nodes:
+            if isinstance(node, ir.BLOCK_TYPES):
+                yield from self.block(node)
+            elif isinstance(node, ir.LinearPath):
+                for _ in range(len(node)):
+                    yield from self.leaf()
+            else:
+                yield from self.leaf()
+
+    def leaf(self) -> Iterator[PostStep]:
+        step = self.by_index.get(self.cursor)
+        self.cursor += 1
+        if step is not None:
+            yield step
+
+    def block(self, node: Any) -> Iterator[PostStep]:
+        if isinstance(node, ir.If):
+            for k, branch in enumerate(node.branches):
+                yield _marker("if" if k == 0 else "elif", node if k == 0 else branch, branch.span)
+                yield from self.nodes(branch.body)
+            if node.orelse:
+                yield _marker("else", node, node.span)
+                yield from self.nodes(node.orelse)
+            yield _marker("end_if", node, node.span)
+        elif isinstance(node, ir.Switch):
+            yield _marker("switch", node, node.span)
+            for case in node.cases:
+                yield _marker("case", case, case.span)
+                yield from self.nodes(case.body)
+            if node.default:
+                yield _marker("default", node, node.span)
+                yield from self.nodes(node.default)
+            yield _marker("end_switch", node, node.span)
+        elif isinstance(node, ir.Repeat):
+            yield _marker("repeat", node, node.span)
+            yield from self.nodes(node.body)
+            yield _marker("until", node, node.span)
+        else:
+            yield _marker(node.kind, node, node.span)
+            yield from self.nodes(node.body)
+            yield _marker(_CLOSERS[type(node)], node, node.span)
+
+
+def _marker(kind: str, node: Any, span: ir.SourceSpan) -> PostStep:
+    return PostStep(-1, kind, span.location, node)
+
+
+_MARKERS = frozenset(
+    {"if", "elif", "else", "end_if", "switch", "case", "default", "end_switch", "while"}
+    | {"end_while", "repeat", "until", "loop", "end_loop", "for", "end_for", "label"}
+)
+
+
+def _fresh_after_boundaries(steps: Sequence[PostStep]) -> Iterator[PostStep]:
+    stale: set[str] = set()
+    for step in steps:
+        if step.kind in _MARKERS:
+            stale = {"tool", "frame", "zone", "joint", "linear"}
+            yield step
+            continue
+        if not isinstance(step.instruction, ir.MOTION_TYPES) or not stale:
+            yield step
+            continue
+        speed = "joint" if step.kind == "joint" else "linear"
+        fresh = speed in stale
+        stale -= {"tool", "frame", "zone", speed}
+        yield dataclasses.replace(
+            step,
+            new_tool=True,
+            new_frame=True,
+            new_zone=True,
+            new_joint_speed=step.new_joint_speed or (fresh and speed == "joint"),
+            new_linear_speed=step.new_linear_speed or (fresh and speed == "linear"),
+        )

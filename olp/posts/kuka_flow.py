@@ -1,0 +1,167 @@
+"""KRL spelling of :mod:`olp.ir_flow` expressions and statements, for the KUKA post.
+
+Operators: ``and``/``or``/``xor``/``not`` -> ``AND``/``OR``/``EXOR``/``NOT``; ``bit_*`` ->
+``B_AND``/``B_OR``/``B_EXOR``/``B_NOT``; ``geometric`` -> ``:``; comparisons and arithmetic as
+they are. Every nested binary operation is parenthesised, so the meaning never depends on
+KRL's priorities (the source's own parentheses are not kept). Constants: ``TRUE``/``FALSE``,
+integers, reals (Python's shortest round-trip form, locale-independent), strings in double
+quotes, enumeration values as ``#NAME``; ``DigitalInput(n)`` is ``$IN[n]``.
+
+User text is never code: names must be KRL identifiers and strings may not hold a double quote
+or a control character (:func:`flow_problem` says what cannot be written; the post reports it on
+the statement's line and writes nothing).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from typing import Any
+
+from olp import ir
+
+_BINARY = {
+    "and": "AND",
+    "or": "OR",
+    "xor": "EXOR",
+    "bit_and": "B_AND",
+    "bit_or": "B_OR",
+    "bit_xor": "B_EXOR",
+    "geometric": ":",
+}
+_UNARY = {"not": "NOT ", "bit_not": "B_NOT ", "-": "-", "+": "+"}
+_IDENTIFIER = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]*\Z")
+INT_MIN, INT_MAX = -(2**31), 2**31 - 1
+"""KRL's INT is a 32-bit signed integer."""
+
+
+def krl_expr(expr: ir.Expr | None, nested: bool = False) -> str:
+    """``expr`` as KRL (None, an argument or index left out, is empty)."""
+    if expr is None:
+        return ""
+    if isinstance(expr, ir.Constant):
+        return _constant(expr)
+    if isinstance(expr, ir.Name):
+        return expr.name
+    if isinstance(expr, ir.Index):
+        return f"{krl_expr(expr.base)}[{','.join(krl_expr(i) for i in expr.indices)}]"
+    if isinstance(expr, ir.Member):
+        return f"{krl_expr(expr.base)}.{expr.field}"
+    if isinstance(expr, ir.DigitalInput):
+        return f"$IN[{expr.index}]"
+    if isinstance(expr, ir.FunctionCall):
+        return f"{expr.name}({', '.join(krl_expr(a) for a in expr.args)})"
+    if isinstance(expr, ir.UnaryOp):
+        return f"{_UNARY[expr.op]}{krl_expr(expr.operand, nested=True)}"
+    if isinstance(expr, ir.BinaryOp):
+        op = _BINARY.get(expr.op, expr.op)
+        text = f"{krl_expr(expr.left, True)} {op} {krl_expr(expr.right, True)}"
+        return f"({text})" if nested else text
+    assert isinstance(expr, ir.Aggregate)
+    head = f"{expr.type_name}: " if expr.type_name else ""
+    members = ", ".join(f"{name} {krl_expr(value)}" for name, value in expr.members)
+    return "{" + head + members + "}"
+
+
+def _constant(expr: ir.Constant) -> str:
+    value = expr.value
+    if expr.enum:
+        return f"#{value}"
+    if isinstance(value, bool):
+        return "TRUE" if value else "FALSE"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        return repr(value)
+    return f'"{value}"'
+
+
+def krl_decl(step: Any) -> str:
+    """A :class:`olp.ir.Declare` as ``DECL TYPE name[dims]=value``."""
+    decl: ir.Declare = step.instruction
+    dims = f"[{','.join(krl_expr(d) for d in decl.dims)}]" if decl.dims else ""
+    value = "" if decl.value is None else f"={krl_expr(decl.value)}"
+    prefix = ("GLOBAL " if decl.exported else "") + ("CONST " if decl.constant else "")
+    return f"DECL {prefix}{decl.type_name} {decl.name}{dims}{value}"
+
+
+def flow_problem(node: Any) -> str | None:
+    """Why ``node`` (a flow statement or block) cannot be written as KRL, or None."""
+    for name in _names(node):
+        if not _IDENTIFIER.match(name):
+            return f"{name!r} is not a KRL name"
+    for expr in _exprs(node):
+        problem = _expr_problem(expr)
+        if problem is not None:
+            return problem
+    return None
+
+
+def _names(node: Any) -> list[str]:
+    if isinstance(node, ir.Declare):
+        return [node.name, node.type_name]
+    if isinstance(node, ir.Label | ir.Goto):
+        return [node.name if isinstance(node, ir.Label) else node.label]
+    if isinstance(node, ir.For):
+        return [node.variable]
+    return []
+
+
+def _exprs(node: Any) -> list[Any]:
+    fields = ("condition", "value", "target", "subject", "start", "stop", "step", "until")
+    found = [getattr(node, f, None) for f in fields] + list(getattr(node, "dims", ()))
+    found += [b.condition for b in getattr(node, "branches", ())]
+    found += [v for c in getattr(node, "cases", ()) for v in c.values]
+    return [e for e in found if e is not None]
+
+
+def _expr_problem(expr: Any) -> str | None:
+    if isinstance(expr, ir.Constant):
+        return _constant_problem(expr)
+    if isinstance(expr, ir.Name | ir.FunctionCall) and not _IDENTIFIER.match(expr.name):
+        return f"{expr.name!r} is not a KRL name"
+    if isinstance(expr, ir.Member) and not _IDENTIFIER.match(expr.field):
+        return f"{expr.field!r} is not a KRL name"
+    if isinstance(expr, ir.Aggregate):
+        bad = [n for n, _ in expr.members if not _IDENTIFIER.match(n)]
+        if bad or (expr.type_name and not _IDENTIFIER.match(expr.type_name)):
+            return f"the structure value {krl_expr(expr)!r} has a member that is not a KRL name"
+    for child in _children(expr):
+        problem = _expr_problem(child)
+        if problem is not None:
+            return problem
+    return None
+
+
+def _constant_problem(expr: ir.Constant) -> str | None:
+    value = expr.value
+    if expr.enum and not (isinstance(value, str) and _IDENTIFIER.match(value)):
+        return f"#{value} is not a KRL enumeration value"
+    if isinstance(value, float) and not math.isfinite(value):
+        return f"{value} is not a number KRL can hold"
+    if isinstance(value, int) and not isinstance(value, bool) and not INT_MIN <= value <= INT_MAX:
+        return f"{value} is outside KRL's INT range ({INT_MIN} .. {INT_MAX})"
+    bad_text = isinstance(value, str) and not expr.enum and ('"' in value or _has_control(value))
+    if bad_text:
+        return f"the text {value!r} holds a double quote or a control character"
+    return None
+
+
+def _has_control(text: str) -> bool:
+    return any(ord(c) < 32 or 127 <= ord(c) < 160 for c in text)
+
+
+def _children(expr: Any) -> list[Any]:
+    if isinstance(expr, ir.BinaryOp):
+        return [expr.left, expr.right]
+    if isinstance(expr, ir.UnaryOp):
+        return [expr.operand]
+    if isinstance(expr, ir.Index):
+        return [expr.base, *(i for i in expr.indices if i is not None)]
+    if isinstance(expr, ir.Member):
+        return [expr.base]
+    if isinstance(expr, ir.FunctionCall):
+        return [a for a in expr.args if a is not None]
+    if isinstance(expr, ir.Aggregate):
+        return [v for _, v in expr.members]
+    return []

@@ -1,0 +1,144 @@
+"""Nothing a KRL program says is dropped silently (issue 15): what olp does not model is kept as
+written (:class:`olp.ir.Verbatim`) or is a warning, never only an info line."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import olp
+from olp import ir
+from olp.frontends.bundled import KrlOptions
+from olp.frontends.krl import load_krl
+
+REPO = Path(__file__).resolve().parents[2]
+STATION = REPO / "stations" / "kr6_milling_cell.yaml"
+CORPUS = REPO / "tests" / "corpus" / "krc" / "R1"
+CONFIG = REPO / "examples" / "robot_config.dat"
+
+
+@pytest.fixture(scope="module")
+def station() -> object:
+    return olp.load_station(STATION)
+
+
+def build(station: object, path: Path, post: str = "kuka") -> olp.api.BuildResult:
+    options = KrlOptions(config_dat=CONFIG)
+    return olp.build(station, path, post=post, program_options=options, collisions=None)
+
+
+def test_path_acceleration_reaches_the_krl_output(station: object) -> None:
+    """``$ACC.CP = 2.0`` is a motion parameter olp models (issue 13): the KRL post writes it
+    with the path speed, before the first LIN."""
+    result = build(station, REPO / "examples" / "facing_mill.src")
+    assert result.ok
+    src = result.files["Facing_Mill.src"].splitlines()
+    assert "$ACC.CP = 2.0000" in src
+    assert src.index("$ACC.CP = 2.0000") < next(i for i, t in enumerate(src) if t.startswith("LIN"))
+
+
+@pytest.mark.parametrize(
+    ("post", "written"),
+    [
+        ("abb", "PathAccLim TRUE \\AccMax:=2.000, TRUE \\DecelMax:=2.000;"),
+        ("ur", "a=2.00000"),
+        ("fanuc", None),
+    ],
+)
+def test_the_path_acceleration_reaches_another_vendor(
+    station: object, post: str, written: str | None
+) -> None:
+    """Written where the language can say it, a warning on the first LIN where it cannot."""
+    result = build(station, REPO / "examples" / "facing_mill.src", post)
+    assert not [d for d in result.diagnostics if d.severity == "error"]
+    text = "".join(result.files.values())
+    warned = [d for d in result.diagnostics if d.kind == "acceleration"]
+    if written is None:
+        assert len(warned) == 1 and "TCP path acceleration" in warned[0].message
+    else:
+        assert written in text and not warned
+
+
+def test_calls_with_effects_and_the_checks_of_their_results_are_kept() -> None:
+    result = load_krl(CORPUS / "Program" / "rsi_correction.src", CONFIG)
+    kinds = [(n.kind, n.span.line) for n in result.program.instructions]
+    assert [k for k in kinds if k[0] in ("assign", "if")] == [
+        ("assign", 14),  # ret=RSI_CREATE(...)
+        ("if", 15),  # IF (ret <> RSIOK) THEN HALT ENDIF
+        ("assign", 18),
+        ("if", 19),
+        ("assign", 23),
+        ("if", 24),
+    ]
+    create = result.program.instructions[[k for k, _ in kinds].index("assign", 2)]
+    assert isinstance(create, ir.Assign) and isinstance(create.value, ir.FunctionCall)
+    assert create.value.name == "RSI_CREATE" and len(create.value.args) == 3
+    check = next(n for n in result.program.instructions if isinstance(n, ir.If))
+    (halt,) = check.branches[0].body
+    assert isinstance(halt, ir.Verbatim) and halt.text == "HALT"
+
+
+def test_the_krl_post_writes_the_calls_and_their_checks(station: object) -> None:
+    result = build(station, CORPUS / "Program" / "rsi_correction.src")
+    lines = result.files["rsi_correction.src"].replace("\r", "").splitlines()
+    start = lines.index('ret = RSI_CREATE("RSI_Ethernet.rsix", CONTID, TRUE)')
+    assert lines[start + 1 : start + 5] == [
+        "IF ret <> RSIOK THEN",
+        "HALT",
+        "ENDIF",
+        "ret = RSI_ON(#RELATIVE)",
+    ]
+
+
+def test_no_statement_of_the_program_is_dropped_at_info_level(station: object) -> None:
+    for name in ("pendant_pick.src", "facing_mill.src"):
+        result = build(station, REPO / "examples" / name)
+        src = str(REPO / "examples" / name)
+        ours = [d for d in result.diagnostics if d.span and d.span.file == src]
+        quiet = [d for d in ours if d.severity == "info" and d.kind in ("ignored", "verbatim")]
+        assert all(d.kind == "verbatim" for d in quiet), [d.format() for d in quiet]
+        # facing_mill's one kept line was $ACC.CP, which olp now models (issue 13)
+        assert quiet or name == "facing_mill.src"
+        assert any(d.kind == "ignored" and d.severity == "warning" for d in result.diagnostics)
+
+
+def test_verbatim_is_one_line() -> None:
+    span = ir.GENERATED
+    with pytest.raises(ir.FlowError, match="one line"):
+        ir.Verbatim(text="$ACC.CP = 2\nPTP {A1 0}", language="krl", span=span)
+    with pytest.raises(ir.FlowError, match="statement"):
+        ir.Verbatim(text="  ", language="krl")
+
+
+def test_a_motion_to_where_the_robot_is_is_kept_as_written() -> None:
+    from olp.frontends.krl import parse_krl
+
+    result = parse_krl("DEF p( )\nPTP $POS_ACT\nPTP $AXIS_ACT C_PTP\nWAIT SEC 1\nEND\n")
+    kept = [(i.kind, getattr(i, "text", ""), i.span.line) for i in result.program]
+    assert kept == [
+        ("verbatim", "PTP $POS_ACT", 2),
+        ("verbatim", "PTP $AXIS_ACT C_PTP", 3),
+        ("wait", "", 4),
+    ]
+
+
+def test_a_copied_post_may_leave_foreign_lines_out_with_a_warning(
+    station: object, tmp_path: Path
+) -> None:
+    import shutil
+
+    folder = tmp_path / "abb_drop"
+    shutil.copytree(REPO / "posts" / "abb", folder)
+    manifest = folder / "post.yaml"
+    text = manifest.read_text().replace("options:\n", "options:\n  foreign_verbatim: drop\n", 1)
+    manifest.write_text(text)
+    # $ADVANCE is kept as written ($ACC.CP, the example before, is now modelled: issue 13)
+    program = tmp_path / "facing_mill.src"
+    mill = (REPO / "examples" / "facing_mill.src").read_text()
+    program.write_text(mill.replace("$ACC.CP = 2.0", "$ADVANCE = 3"))
+    result = build(station, program, str(folder))
+    assert result.ok and result.files
+    (dropped,) = [d for d in result.diagnostics if d.kind == "verbatim_dropped"]
+    assert dropped.severity == "warning" and "'$ADVANCE = 3' (line 12)" in dropped.message
+    assert "ADVANCE" not in "".join(result.files.values())

@@ -1,0 +1,119 @@
+"""The KRL post writes control flow and data (issue 15, step 5); the other posts stop on them
+with an error naming the first one."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import olp
+from olp import ir
+from olp.frontends.bundled import KrlOptions
+from olp.frontends.krl import load_krl
+from olp.ir_flow import leaves_and_blocks
+
+REPO = Path(__file__).resolve().parents[2]
+CORPUS = REPO / "tests" / "corpus" / "krc" / "R1"
+CONFIG = CORPUS / "System" / "$config.dat"
+BUILDS = sorted(p.name for p in (CORPUS / "Program").glob("*.src") if p.stem != "home_check")
+
+
+@pytest.fixture(scope="module")
+def station() -> object:
+    return olp.load_station(REPO / "stations" / "kr6_milling_cell.yaml")
+
+
+def build(station: object, source: Path | ir.Program, post: str = "kuka") -> olp.api.BuildResult:
+    options = KrlOptions(config_dat=CONFIG) if isinstance(source, Path) else None
+    return olp.build(station, source, post=post, program_options=options, collisions=None)
+
+
+def shape(program: ir.Program) -> list[str]:
+    """The program's statements and blocks in order (declarations apart: KRL wants them first);
+    motions and waits by kind, kept lines by their text."""
+    out = []
+    for node in leaves_and_blocks(program.instructions):
+        if isinstance(node, ir.Verbatim):
+            out.append(node.text.upper().replace(" ", ""))
+        elif node.kind != "declare":
+            out.append(node.kind)
+    return out
+
+
+def declared(program: ir.Program) -> set[str]:
+    return {n.name.upper() for n in leaves_and_blocks(program.instructions) if n.kind == "declare"}
+
+
+@pytest.mark.parametrize("name", BUILDS)
+def test_krl_to_krl_keeps_every_statement(station: object, name: str, tmp_path: Path) -> None:
+    source = load_krl(CORPUS / "Program" / name, CONFIG).program
+    result = build(station, CORPUS / "Program" / name)
+    assert result.ok, [d.format() for d in result.diagnostics if d.severity == "error"]
+    for file, text in result.files.items():
+        (tmp_path / file).write_text(text)
+    (written,) = [f for f in result.files if f.endswith(".src")]
+    again = load_krl(tmp_path / written).program
+    assert shape(again) == shape(source)
+    assert declared(again) == declared(source)
+    assert len(list(again.motions())) == len(list(source.motions()))
+
+
+@pytest.mark.parametrize("post", ["abb", "ur", "fanuc"])
+def test_other_posts_stop_on_control_flow_naming_it(station: object, post: str) -> None:
+    result = build(station, CORPUS / "Program" / "pick_part.src", post)
+    errors = [d for d in result.diagnostics if d.severity == "error"]
+    assert [(d.kind, d.span.line if d.span else 0) for d in errors] == [("control_flow", 22)]
+    assert "if at line 22" in errors[0].message and not result.files
+
+
+def down(x: float, speed: float, line: int) -> ir.LinearMove:
+    pose = np.eye(4)
+    pose[:3, :3] = np.diag([1.0, -1.0, -1.0])
+    pose[:3, 3] = [x, -0.4, 0.3]
+    span = ir.SourceSpan("t.src", line, 1)
+    return ir.LinearMove(
+        target=ir.CartesianTarget(pose=pose), speed=ir.Speed(linear=speed), span=span
+    )
+
+
+def test_settings_are_written_again_after_a_block(station: object) -> None:
+    home = ir.JointMove(target=ir.JointTarget(joints=np.radians([0, -90, 90, 0, 45, 0])))
+    block = ir.If(
+        branches=(ir.Branch(condition=ir.DigitalInput(index=1), body=(down(0.45, 0.5, 3),)),),
+        orelse=(down(0.5, 0.1, 5),),
+        span=ir.SourceSpan("t.src", 2, 1),
+    )
+    program = ir.Program(
+        name="p", instructions=(home, down(0.5, 0.1, 1), block, down(0.55, 0.1, 7))
+    )
+    lines = build(station, program).files["p.src"].replace("\r", "").splitlines()
+    last = max(i for i, line in enumerate(lines) if line.startswith("LIN"))
+    assert lines[lines.index("ENDIF") + 1 : last] == [
+        "$BASE = $NULLFRAME ; world",
+        "$TOOL = $NULLFRAME ; flange",
+        "$VEL.CP = 0.10000",  # the then-branch ran at 0.5 m/s
+    ]
+
+
+def test_text_that_krl_cannot_hold_is_an_error(station: object) -> None:
+    bad = ir.Assign(
+        target=ir.Name(name="sText"),
+        value=ir.Constant(value='a"; $OUT[1]=TRUE'),
+        span=ir.SourceSpan("t.src", 4, 1),
+    )
+    result = build(station, ir.Program(name="p", instructions=(bad,)))
+    errors = [
+        (d.kind, d.span.line if d.span else 0) for d in result.diagnostics if d.severity == "error"
+    ]
+    assert errors == [("flow", 4)] and not result.files
+
+
+def test_numbers_krl_cannot_hold_are_errors_not_crashes(station: object, tmp_path: Path) -> None:
+    src = tmp_path / "big.src"
+    src.write_text("DEF big( )\nDECL INT n\nn = " + "9" * 400 + "\nm = 3000000000\nEND\n")
+    result = olp.build(station, src, collisions=None)
+    found = [d for d in result.diagnostics if d.severity == "error"]
+    assert [(d.kind, d.span.line if d.span else 0) for d in found] == [("flow", 3), ("flow", 4)]
+    assert not result.files
