@@ -2,8 +2,9 @@
 ``(CompiledProgram, BuildOptions) -> CompiledProgram`` (its findings appended to the
 diagnostics), and a pipeline is a tuple of them.
 
-:data:`PIPELINE` is what ``olp build`` runs (resolve, collisions, timing); :data:`CHECKS` what
-``olp check`` runs (no timing: it reports none). A user or a later feature adds a pass by
+:data:`PIPELINE` is what ``olp build`` and ``olp check`` run (resolve, flow, collisions,
+timing: ``olp check`` reports the cycle time too); :data:`CHECKS` is every check without timing,
+for a caller that wants the checks only. A user or a later feature adds a pass by
 writing one function and handing ``olp.compile(..., passes=(...))`` a tuple with it::
 
     def thin_points(compiled, options):
@@ -57,7 +58,7 @@ PIPELINE: tuple[Pass, ...] = (
 """What a build runs."""
 
 CHECKS: tuple[Pass, ...] = (resolve_pass, flow_pass, collision_pass)
-"""What ``olp check`` runs: every check, no timing."""
+"""Every check, no timing (``olp.compile(..., passes=CHECKS)``)."""
 
 
 def run_passes(
