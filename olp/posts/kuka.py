@@ -230,10 +230,8 @@ def krl_rows(post: Post, rows: PostRows, modal: Modal, arcs_written: bool = Fals
     targets' numbers are formatted as columns. Every piece is a checked number, a legal name or
     a keyword, so the lines are :class:`~olp.posts.sandbox.SafeText`."""
     steps = rows.steps
-    n = len(steps)
-    frames = pose_to_frame(rows.poses())
-    xyz = post.number_column("position", frames[:, :3], steps)
-    abc = post.number_column("angle", frames[:, 3:], steps)
+    named = post.options.get("points", "inline") == "dat"
+    targets = [s.name for s in steps] if named else [f"{{{t}}}" for t in _e6pos_texts(post, rows)]
     mode = str(post.options.get("frames", "inline"))
     lines: list[str] = []
     for k, step in enumerate(steps):
@@ -258,15 +256,33 @@ def krl_rows(post: Post, rows: PostRows, modal: Modal, arcs_written: bool = Fals
             lines.append(f"$APO.CDIS = {post.number('cdis', zone.radius * 1000)}")
         if arcs_written and modal.changed("ori_type", "VAR"):
             lines.append("$ORI_TYPE = #VAR")
-        p, o = 3 * k, 3 * k
-        target = (
-            f"X {xyz[p]},Y {xyz[p + 1]},Z {xyz[p + 2]},A {abc[o]},B {abc[o + 1]},C {abc[o + 2]}"
+        lines.append(f"LIN {targets[k]}" + ("" if fine else " C_DIS"))
+    post.current_step = rows
+    return SafeText("\n".join(lines))
+
+
+def krl_rows_dat(post: Post, rows: PostRows) -> SafeText:
+    """The .dat declarations of a run of LINs with named points (``points: dat``), exactly as
+    ``program.dat.j2`` writes each: ``DECL E6POS XP12={X ..,S ..,T ..}``."""
+    texts = _e6pos_texts(post, rows)
+    lines = [f"DECL E6POS {s.name}={{{t}}}" for s, t in zip(rows.steps, texts, strict=True)]
+    return SafeText("\n".join(lines))
+
+
+def _e6pos_texts(post: Post, rows: PostRows) -> list[str]:
+    """Each row's E6POS without braces (:func:`krl_e6pos`), its numbers formatted as columns."""
+    steps = rows.steps
+    frames = pose_to_frame(rows.poses())
+    xyz = post.number_column("position", frames[:, :3], steps)
+    abc = post.number_column("angle", frames[:, 3:], steps)
+    out = []
+    for k, step in enumerate(steps):
+        p = 3 * k
+        out.append(
+            f"X {xyz[p]},Y {xyz[p + 1]},Z {xyz[p + 2]},A {abc[p]},B {abc[p + 1]},C {abc[p + 2]}"
             f",S {int(step.vendor['status'])},T {int(step.vendor['turn'])}"
         )
-        lines.append(f"LIN {{{target}}}" + ("" if fine else " C_DIS"))
-    post.current_step = rows
-    assert len(xyz) == len(abc) == 3 * n
-    return SafeText("\n".join(lines))
+    return out
 
 
 def _is_identity(pose: ArrayLike) -> bool:
@@ -298,6 +314,7 @@ FILTERS: Mapping[str, Filter] = {
     "krl_arc_types": krl_arc_types,
     "krl_ca": krl_ca,
     "krl_rows": krl_rows,
+    "krl_rows_dat": krl_rows_dat,
     "krl_expr": lambda post, expr: krl_expr(expr),
     "krl_decl": lambda post, step: krl_decl(step),
 }
@@ -325,11 +342,6 @@ class KukaPost(Post):
     ARC_ORIENTATIONS = frozenset(ARC_TYPES) - {ArcOrientation.WRIST}
     ARC_ANGLE = True
     ROWS = True
-
-    def rows_enabled(self) -> bool:
-        """Runs of LINs go to :func:`krl_rows` with inline points (named points also need their
-        declarations in the .dat, which its template writes per motion)."""
-        return super().rows_enabled() and self.options.get("points", "inline") == "inline"
 
     def step_values(self, robot: Any, joints: Any) -> list[Mapping[str, Any]]:
         """Status and Turn of each motion's planned joints (N, 6) rad, and whether Turn cannot

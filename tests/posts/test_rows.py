@@ -72,9 +72,14 @@ def _varied(program: ir.Program) -> ir.Program:
     return program.replace_instructions(out)
 
 
-def _both(post_name: str, program: ir.Program) -> tuple[olp.BuildResult, olp.BuildResult]:
+def _both(
+    post_name: str, program: ir.Program, **options: object
+) -> tuple[olp.BuildResult, olp.BuildResult]:
     station = olp.load_station(CELL)
     post = find_post(post_name)
+    if options:
+        manifest = dataclasses.replace(post.manifest, options={**post.manifest.options, **options})
+        post = type(post)(manifest)
     assert post.rows_enabled(), "the bundled folder must use its row writer"
     template = type(post)(dataclasses.replace(post.manifest, rows=False))
     return olp.build(station, program, post), olp.build(station, program, template)
@@ -89,6 +94,16 @@ def test_rows_are_written_as_the_templates_write_them(post: str, tmp_path: Path)
     text = "".join(rows.files.values())
     for piece in PIECES[post]:
         assert piece in text
+
+
+def test_kuka_named_points_rows_are_written_as_the_templates_write_them(tmp_path: Path) -> None:
+    """``points: dat``: the LINs name their points and the .dat declares them (krl_rows_dat)."""
+    rows, template = _both("kuka", _varied(_moves(40, tmp_path)), points="dat")
+    assert rows.ok, [d.format() for d in rows.diagnostics]
+    assert rows.files == template.files
+    dat = next(text for name, text in rows.files.items() if name.endswith(".dat"))
+    src = next(text for name, text in rows.files.items() if name.endswith(".src"))
+    assert "DECL E6POS XP40={X " in dat and "LIN XP40" in src
 
 
 # Fanuc writes an L speed below 1 mm/sec as 1mm/sec with a warning (speed_raised), no error.
