@@ -48,7 +48,7 @@ mesh is an error at the ``file:`` that names it.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -616,13 +616,7 @@ def _targets(
             raise src.error((*where, "name"), f"duplicate target name '{target_name}'")
         if "description" in item:
             text(src, item["description"], (*where, "description"))
-        frame = text(src, item.get("frame", "world"), (*where, "frame"))
-        if frame != "world" and frame not in frames:
-            raise src.error(
-                (*where, "frame"),
-                f"unknown frame '{shorten(frame)}' "
-                f"(frames: {shorten(', '.join(frames) or 'none')})",
-            )
+        frame = _frame_name(src, item, where, frames)
         if ("pose" in item) == ("joints_deg" in item):
             raise src.error(where, "give a target either a 'pose' or 'joints_deg', exactly one")
         if "pose" in item:
@@ -802,13 +796,7 @@ def _objects(
         seen.add(object_name)
         if "description" in item:
             text(src, item["description"], (*where, "description"))
-        frame = text(src, item.get("frame", "world"), (*where, "frame"))
-        if frame != "world" and frame not in frames:
-            raise src.error(
-                (*where, "frame"),
-                f"unknown frame '{shorten(frame)}' "
-                f"(frames: {shorten(', '.join(frames) or 'none')})",
-            )
+        frame = _frame_name(src, item, where, frames)
         above = np.eye(4) if frame == "world" else frames[frame].pose
         assert above is not None
         shapes = _shapes(src, get(src, item, where, "geometry"), (*where, "geometry"))
@@ -817,3 +805,17 @@ def _objects(
         pose = above @ _pose(src, item.get("pose"), (*where, "pose"))
         out.append(StationObject(object_name, object_kind, pose, shapes, frame))  # type: ignore[arg-type]
     return out
+
+
+def _frame_name(
+    src: Any, item: Mapping[str, Any], where: KeyPath, frames: Mapping[str, Any]
+) -> str:
+    """An item's ``frame`` (default ``world``): ``world`` or a frame of the station, else a
+    located error listing the frames."""
+    frame = text(src, item.get("frame", "world"), (*where, "frame"))
+    if frame != "world" and frame not in frames:
+        raise src.error(
+            (*where, "frame"),
+            f"unknown frame '{shorten(frame)}' (frames: {shorten(', '.join(frames) or 'none')})",
+        )
+    return frame
