@@ -212,12 +212,6 @@ def estimate_scope(compiled: CompiledProgram) -> tuple[str, str]:
             "; the controller's own path acceleration where the program sets none (unknown "
             "to the station: olp time --calibrate fits it from a recording)"
         )
-    unset = [m for m in path if m.speed.linear_acceleration is None]
-    if unset and not on_ur and compiled.station.robot.limits.path_acceleration is None:
-        excludes += (
-            "; the controller's own path acceleration where the program sets none (unknown "
-            "to the station: olp time --calibrate fits it from a recording)"
-        )
     stops = sum(1 for d in compiled.diagnostics if d.kind == "zone_stop")
     if stops:
         excludes += (
