@@ -288,3 +288,12 @@ def test_assumptions_that_name_nothing_are_usage_errors(station: Station) -> Non
 def test_a_straight_program_has_no_paths(station: Station) -> None:
     compiled = olp.compile(program(start(), lin(2, -300)), station, collisions=None)
     assert compiled.paths is None and compiled.cycle_time > 0
+
+
+def test_declarations_alone_leave_the_text_as_the_only_path(station: Station) -> None:
+    declared = ir.Declare(name="n", type_name="INT", value=ir.Constant(value=1))
+    prog = program(declared, start(), lin(2, -300))
+    compiled = olp.compile(prog, station, collisions=None)
+    assert prog.has_flow and compiled.paths is None
+    assert compiled.cycle_time == straight(station, start(), lin(2, -300))
+    assert "flow_timing" not in {d.kind for d in compiled.diagnostics}

@@ -32,11 +32,15 @@ a sum).
 
 from __future__ import annotations
 
+import bisect
 import dataclasses
 import math
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, TypeAlias
+
+import numpy as np
+from numpy.typing import NDArray
 
 from olp import ir
 from olp.compiled import CompiledProgram, PathBlock, items_of, make_steps
@@ -244,7 +248,9 @@ class SegmentTimer:
     def __init__(self, compiled: CompiledProgram, options: BuildOptions) -> None:
         self.compiled = compiled
         self.options = options
-        self.textual = _textual_previous(compiled.program)
+        self.motions = motion_indices(compiled.program)
+        self.items = items_of(compiled.steps)
+        self.starts = [_item_start(item) for item in self.items]
         self.cache: dict[tuple[int, int, int], float] = {}
         self.fallbacks: list[SourceSpan] = []
 
@@ -252,25 +258,26 @@ class SegmentTimer:
         """Seconds of the run ``nodes`` (instruction ``lo`` on) entered at ``entry``, and the
         position it leaves (None: it holds no motion)."""
         hi = lo + _size(nodes)
-        motions = [i for i in range(lo, hi) if i in self.textual]
-        if not motions:
+        first, end = np.searchsorted(self.motions, [lo, hi]).tolist()
+        if first == end:
             key = (lo, hi, START)
             if key not in self.cache:
                 self.cache[key] = sum(s.duration for s in self.compiled.steps[lo:hi])
             return self.cache[key], None
-        from_text = self.textual[motions[0]] == entry
-        key = (lo, hi, START - 1 if from_text else entry)
+        textual = int(self.motions[first - 1]) if first > 0 else START
+        key = (lo, hi, START - 1 if entry == textual else entry)
         if key not in self.cache:
-            if from_text:
+            if entry == textual:
                 self.cache[key] = self._from_text(lo, hi)
             else:
                 self.cache[key] = self._from(entry, lo, hi, nodes)
-        return self.cache[key], motions[-1]
+        return self.cache[key], int(self.motions[end - 1])
 
     def _from_text(self, lo: int, hi: int) -> float:
         from olp.passes.timing.program import time_program
 
-        timed = time_program(_slice(self.compiled, lo, hi), *self._timing())
+        part = self.items[bisect.bisect_left(self.starts, lo) : bisect.bisect_left(self.starts, hi)]
+        timed = time_program(_renumbered(self.compiled, part, lo), *self._timing())
         return timed.cycle_time
 
     def _from(self, entry: int, lo: int, hi: int, nodes: Sequence[Any]) -> float:
@@ -298,16 +305,20 @@ class SegmentTimer:
         return self.options.other_times, self.options.timing
 
 
-def _slice(compiled: CompiledProgram, lo: int, hi: int) -> CompiledProgram:
-    """The steps ``lo`` .. ``hi`` of ``compiled`` as a program of their own (numbered from 0)."""
-    items: list[Any] = []
-    for item in items_of(compiled.steps):
-        if isinstance(item, PathBlock):
-            if lo <= item.start < hi:
-                items.append(dataclasses.replace(item, start=item.start - lo))
-        elif lo <= item.index < hi:
-            items.append(dataclasses.replace(item, index=item.index - lo))
-    return dataclasses.replace(compiled, steps=make_steps(items), diagnostics=())
+def _renumbered(compiled: CompiledProgram, items: Sequence[Any], lo: int) -> CompiledProgram:
+    """``items`` (steps and blocks from instruction ``lo`` on) as a program of their own,
+    numbered from 0."""
+    moved = [
+        dataclasses.replace(item, start=item.start - lo)
+        if isinstance(item, PathBlock)
+        else dataclasses.replace(item, index=item.index - lo)
+        for item in items
+    ]
+    return dataclasses.replace(compiled, steps=make_steps(moved), diagnostics=())
+
+
+def _item_start(item: Any) -> int:
+    return int(item.start if isinstance(item, PathBlock) else item.index)
 
 
 def _size(nodes: Sequence[Any]) -> int:
@@ -315,14 +326,19 @@ def _size(nodes: Sequence[Any]) -> int:
     return sum(len(n) if isinstance(n, ir.LinearPath) else 1 for n in leaves(nodes))
 
 
-def _textual_previous(program: ir.Program) -> dict[int, int]:
-    """Motion index -> the motion the text puts before it (:data:`START` for the first)."""
-    previous, out = START, {}
-    for index, instruction in enumerate(program):
-        if ir.is_motion(instruction):
-            out[index] = previous
-            previous = index
-    return out
+def motion_indices(program: ir.Program) -> NDArray[np.int64]:
+    """The instruction indices of the motions of ``program``, ascending (a toolpath's rows
+    as one range, not one by one)."""
+    parts, cursor = [], 0
+    for node in leaves(program.instructions):
+        if isinstance(node, ir.LinearPath):
+            parts.append(np.arange(cursor, cursor + len(node)))
+            cursor += len(node)
+            continue
+        if ir.is_motion(node):
+            parts.append(np.array([cursor]))
+        cursor += 1
+    return np.concatenate(parts).astype(np.int64) if parts else np.zeros(0, dtype=np.int64)
 
 
 # --------------------------------------------------------------------------------------------
@@ -634,10 +650,11 @@ def _parts(expr: Any) -> Iterator[Any]:
 def path_timing_pass(compiled: CompiledProgram, options: BuildOptions) -> CompiledProgram:
     """Time a program with control flow per path (:func:`path_times`, with
     ``options.assume``) into ``compiled.paths``, with an info note that the per-instruction
-    times follow the text; a program without control flow is left as it is."""
+    times follow the text; a program whose only path is its text (no blocks or jumps, only
+    declarations, assignments and waits) is left as it is."""
     assumptions = getattr(options, "assume", None) or Assumptions()
     program = compiled.program
-    if not program.has_flow:
+    if not program.has_flow or _one_path(program):
         if assumptions.given:
             raise UsageError(
                 f"--assume {assumptions.given[0]!r}: the program has no branches or loops"
@@ -648,6 +665,13 @@ def path_timing_pass(compiled: CompiledProgram, options: BuildOptions) -> Compil
         return compiled
     paths = path_times(compiled, options, assumptions)
     return dataclasses.replace(compiled, paths=paths).with_diagnostics([_note(compiled, paths)])
+
+
+def _one_path(program: ir.Program) -> bool:
+    """Whether the text in order is the program's only path: declarations, assignments and
+    waits, but no block, jump, exit or return."""
+    turns = (*BLOCK_TYPES, ir.Goto, ir.Exit, ir.Return)
+    return not any(isinstance(n, turns) for n in leaves_and_blocks(program.instructions))
 
 
 def _note(compiled: CompiledProgram, paths: PathTimes) -> Diagnostic:
