@@ -297,3 +297,18 @@ def test_declarations_alone_leave_the_text_as_the_only_path(station: Station) ->
     assert prog.has_flow and compiled.paths is None
     assert compiled.cycle_time == straight(station, start(), lin(2, -300))
     assert "flow_timing" not in {d.kind for d in compiled.diagnostics}
+
+
+def test_a_blend_into_a_block_is_timed_as_a_stop(station: Station) -> None:
+    corner = ir.LinearMove(
+        target=ir.CartesianTarget(pose=pose(-300)), zone=ir.Zone(0.02), span=span(2)
+    )
+    fine = ir.LinearMove(target=ir.CartesianTarget(pose=pose(-300)), span=span(2))
+    inside = ir.If(branches=(ir.Branch(condition=IN1, body=(lin(4, -300, 400),)),), span=span(3))
+    prog = program(start(), corner, inside, lin(6, -200, 400))
+    text = olp.compile(prog, station, collisions=None).cycle_time  # blends into line 4
+    taken = ends(paths_of(station, prog, "in1=true"))[0]
+    stopped = straight(station, start(), fine, lin(4, -300, 400), lin(6, -200, 400))
+    assert taken == pytest.approx(stopped, rel=TOL) and text < stopped - 0.01
+    skipped = ends(paths_of(station, prog, "in1=false"))[0]
+    assert skipped == pytest.approx(straight(station, start(), fine, lin(6, -200, 400)), rel=TOL)

@@ -32,7 +32,6 @@ a sum).
 
 from __future__ import annotations
 
-import bisect
 import dataclasses
 import math
 from collections.abc import Iterator, Mapping, Sequence
@@ -43,7 +42,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from olp import ir
-from olp.compiled import CompiledProgram, PathBlock, items_of, make_steps
+from olp.compiled import CompiledProgram, PathBlock, items_of
 from olp.diagnostics import Diagnostic
 from olp.errors import UsageError
 from olp.ir_flow import BLOCK_TYPES, bodies, leaves, leaves_and_blocks
@@ -242,16 +241,36 @@ def _close(a: float, b: float) -> bool:
 # Segments
 
 
+_FROM_TEXT = START - 1
+"""The entry key of a run entered from the motion the text puts before it."""
+
+
+@dataclass(frozen=True, slots=True)
+class _Run:
+    """A run to time: instructions ``lo`` .. ``hi`` (``nodes``), entered at ``entry``."""
+
+    lo: int
+    hi: int
+    nodes: tuple[Any, ...]
+    entry: int
+
+
 class SegmentTimer:
-    """Times runs of instructions from a given position, each once (cached)."""
+    """Times runs of instructions from a given position, each once.
+
+    While ``collecting``, :meth:`time` notes what is asked and answers 0 s (the positions a
+    walk reaches do not depend on times); :meth:`settle` then times every run noted in two
+    calls of the timers: the runs entered from the text's previous motion on the compiled
+    program itself, every run end timed as a stop, and the others resolved again, each after a
+    joint lead-in to its entry, in one program."""
 
     def __init__(self, compiled: CompiledProgram, options: BuildOptions) -> None:
         self.compiled = compiled
         self.options = options
         self.motions = motion_indices(compiled.program)
-        self.items = items_of(compiled.steps)
-        self.starts = [_item_start(item) for item in self.items]
         self.cache: dict[tuple[int, int, int], float] = {}
+        self.pending: dict[tuple[int, int, int], _Run] = {}
+        self.collecting = False
         self.fallbacks: list[SourceSpan] = []
 
     def time(self, lo: int, nodes: Sequence[Any], entry: int) -> tuple[float, int | None]:
@@ -259,66 +278,97 @@ class SegmentTimer:
         position it leaves (None: it holds no motion)."""
         hi = lo + _size(nodes)
         first, end = np.searchsorted(self.motions, [lo, hi]).tolist()
-        if first == end:
-            key = (lo, hi, START)
-            if key not in self.cache:
-                self.cache[key] = sum(s.duration for s in self.compiled.steps[lo:hi])
-            return self.cache[key], None
+        last = int(self.motions[end - 1]) if end > first else None
         textual = int(self.motions[first - 1]) if first > 0 else START
-        key = (lo, hi, START - 1 if entry == textual else entry)
+        key = (lo, hi, _FROM_TEXT if last is None or entry == textual else entry)
         if key not in self.cache:
-            if entry == textual:
-                self.cache[key] = self._from_text(lo, hi)
-            else:
-                self.cache[key] = self._from(entry, lo, hi, nodes)
-        return self.cache[key], int(self.motions[end - 1])
+            self.pending[key] = _Run(lo, hi, tuple(nodes), key[2])
+            if self.collecting:
+                return 0.0, last
+            self.settle()
+        return self.cache[key], last
 
-    def _from_text(self, lo: int, hi: int) -> float:
+    def settle(self) -> None:
+        """Time every run noted (see the class docstring)."""
+        runs, self.pending = list(self.pending.values()), {}
+        others = [r for r in runs if r.entry != _FROM_TEXT]
+        failed = self._from_entries(others)
+        again = [dataclasses.replace(r, entry=_FROM_TEXT) for r in failed]
+        self._from_text([r for r in runs if r.entry == _FROM_TEXT] + again)
+        for run in failed:
+            self.cache[(run.lo, run.hi, run.entry)] = self.cache[(run.lo, run.hi, _FROM_TEXT)]
+
+    def _from_text(self, runs: Sequence[_Run]) -> None:
+        """Runs entered from the text's previous motion: the compiled program timed again with
+        a stop at each run's end and before its start."""
         from olp.passes.timing.program import time_program
 
-        part = self.items[bisect.bisect_left(self.starts, lo) : bisect.bisect_left(self.starts, hi)]
-        timed = time_program(_renumbered(self.compiled, part, lo), *self._timing())
-        return timed.cycle_time
+        if not runs:
+            return
+        bounds = np.array([r.lo for r in runs] + [r.hi for r in runs], dtype=np.int64)
+        ends = np.searchsorted(self.motions, bounds) - 1
+        stops = self.motions[ends[ends >= 0]]
+        timed = self.compiled
+        if any(not self.compiled.steps[i].instruction.zone.is_fine for i in stops.tolist()):
+            timed = time_program(self.compiled, *self._timing(), stops=stops)
+        # else: every run already starts and ends at a stop; the timing pass's times hold
+        totals = np.concatenate([[0.0], np.cumsum(_durations(timed))])
+        for run in runs:
+            self.cache[(run.lo, run.hi, _FROM_TEXT)] = float(totals[run.hi] - totals[run.lo])
 
-    def _from(self, entry: int, lo: int, hi: int, nodes: Sequence[Any]) -> float:
-        """The run resolved and timed from the end of motion ``entry``: a joint lead-in to it
-        (its time not counted), then the run."""
+    def _from_entries(self, runs: Sequence[_Run]) -> list[_Run]:
+        """Runs entered from another motion: each resolved and timed after a joint lead-in to
+        that motion's end (not counted), all in one program; returns the runs that failed
+        there (timed from the text's start instead, and said so)."""
         from olp.passes.resolve import resolve
         from olp.passes.timing.program import time_program
 
-        joints = self.compiled.start_joints if entry == START else self.compiled.steps[entry].joints
-        first = next(n for n in leaves(nodes))
-        if joints is None:
-            return self._from_text(lo, hi)
-        lead = ir.JointMove(target=ir.JointTarget(joints=joints), span=first.span)
-        mini = ir.Program(
-            name="segment", instructions=(lead, *nodes), source=self.compiled.program.source
+        if not runs:
+            return []
+        nodes: list[Any] = []
+        firsts = []
+        for run in runs:
+            joints = self._joints(run.entry)
+            span = next(leaves(run.nodes)).span
+            firsts.append(sum(_size((n,)) for n in nodes))
+            nodes += [ir.JointMove(target=ir.JointTarget(joints=joints), span=span), *run.nodes]
+        program = ir.Program(
+            name="runs", instructions=tuple(nodes), source=self.compiled.program.source
         )
-        resolved = resolve(mini, self.compiled.station, self.options.resolve)
-        timed = time_program(resolved, *self._timing())
-        if any(d.severity == "error" and (d.index or 0) >= 1 for d in timed.diagnostics):
-            self.fallbacks.append(first.span)
-            return self._from_text(lo, hi)
-        return timed.cycle_time - timed.steps[0].duration
+        resolved = resolve(program, self.compiled.station, self.options.resolve)
+        ends = np.array([f + 1 + r.hi - r.lo for f, r in zip(firsts, runs, strict=True)])
+        motions = motion_indices(program)
+        stops = motions[np.searchsorted(motions, ends) - 1]  # each run's last motion
+        timed = time_program(resolved, *self._timing(), stops=stops)
+        totals = np.concatenate([[0.0], np.cumsum(_durations(timed))])
+        bad = {d.index for d in timed.diagnostics if d.severity == "error"}
+        failed = []
+        for first, run in zip(firsts, runs, strict=True):
+            rows = range(first + 1, first + 1 + run.hi - run.lo)
+            if any(i in bad for i in rows):
+                self.fallbacks.append(next(leaves(run.nodes)).span)
+                failed.append(run)
+                continue
+            self.cache[(run.lo, run.hi, run.entry)] = float(totals[rows.stop] - totals[rows.start])
+        return failed
+
+    def _joints(self, entry: int) -> Any:
+        joints = self.compiled.start_joints if entry == START else self.compiled.steps[entry].joints
+        return self.compiled.start_joints if joints is None else joints
 
     def _timing(self) -> tuple[Mapping[str, float], Any]:
         return self.options.other_times, self.options.timing
 
 
-def _renumbered(compiled: CompiledProgram, items: Sequence[Any], lo: int) -> CompiledProgram:
-    """``items`` (steps and blocks from instruction ``lo`` on) as a program of their own,
-    numbered from 0."""
-    moved = [
-        dataclasses.replace(item, start=item.start - lo)
-        if isinstance(item, PathBlock)
-        else dataclasses.replace(item, index=item.index - lo)
-        for item in items
-    ]
-    return dataclasses.replace(compiled, steps=make_steps(moved), diagnostics=())
-
-
-def _item_start(item: Any) -> int:
-    return int(item.start if isinstance(item, PathBlock) else item.index)
+def _durations(compiled: CompiledProgram) -> NDArray[np.float64]:
+    """Seconds per instruction (n,) of a timed program, a toolpath's rows from its arrays."""
+    parts = []
+    for item in items_of(compiled.steps):
+        if isinstance(item, PathBlock):
+            parts.append(np.zeros(len(item)) if item.durations is None else item.durations)
+        else:
+            parts.append(np.array([item.duration]))
+    return np.concatenate(parts) if parts else np.zeros(0)
 
 
 def _size(nodes: Sequence[Any]) -> int:
@@ -357,6 +407,10 @@ class _Walk:
         self.done: States = {}
         self.notes: dict[tuple[str, int, int], str] = {}
         self.used_loops: set[int | str] = set()
+
+    def all(self, nodes: Sequence[Any]) -> States:
+        """The states at the end of the program ``nodes`` (its end or a return)."""
+        return _merged(self.body(nodes, {START: _Bound(0.0, (), 0.0, ())}), self.done)
 
     def body(self, nodes: Sequence[Any], states: States) -> States:
         run: list[Any] = []
@@ -447,6 +501,8 @@ class _Walk:
         before: States | None = None
         current, last_exits = states, dict[int, _Bound]()
         for k in range(passes):
+            if self.timer.collecting and before is not None and before.keys() == current.keys():
+                break  # later passes start from the same positions: they time the same runs
             step = None if before is None else _uniform_step(before, current)
             if step is not None:
                 # Every pass from here on adds ``step`` (a path's time is a sum): jump to the end.
@@ -554,8 +610,13 @@ def path_times(
             "only the text's in order"
         )
         return PathTimes(None, None, given.given, reason=reason)
-    walk = _Walk(SegmentTimer(compiled, options), environment(program.instructions, given), given)
-    end = _merged(walk.body(program.instructions, {START: _Bound(0.0, (), 0.0, ())}), walk.done)
+    env, timer = environment(program.instructions, given), SegmentTimer(compiled, options)
+    timer.collecting = True  # a first walk notes every run to time, the second adds them up
+    _Walk(timer, env, given).all(program.instructions)
+    timer.collecting = False
+    timer.settle()
+    walk = _Walk(timer, env, given)
+    end = walk.all(program.instructions)
     _check_loops_used(walk, given)
     notes = [walk.notes[k] for k in sorted(walk.notes)]
     notes += [
