@@ -10,8 +10,11 @@ pass's own timers (:func:`~olp.passes.timing.program.time_program`).
   (on every path that reaches it: after ``IF ... ELSE`` from either branch's end, at a loop's
   head from before the loop or from its last pass), and at rest: **a blend across a block
   boundary is timed as an exact stop**. A segment entered from the motion the text puts before
-  it reuses the resolve pass's joints; from another motion it is resolved again from that
-  motion's end (a joint lead-in to it, timed apart).
+  it keeps the timing pass's times (timed again with stops at the segment's ends where a zone
+  crosses one); from another motion it is resolved again from that motion's end (a joint
+  lead-in to it, not counted). That end is the joints the resolve pass found for the motion
+  along the text, as in :mod:`olp.passes.flow`: a Cartesian target reached along another path
+  is taken in the same configuration.
 * **Branches.** A condition is folded with what is known (:mod:`.conditions`: ``--assume``
   values, constants); a branch whose condition is known false is never taken, the first one
   known true always. A choice that stays open gives the range: the shortest and the longest
@@ -25,9 +28,13 @@ pass's own timers (:func:`~olp.passes.timing.program.time_program`).
 * **Jumps.** A program with ``GOTO`` is not walked (its paths are not blocks): it gets no
   path time, and a note says so.
 
-Long loops cost little: once a pass shifts every state by the same time and the same choices
-as the pass before it, the remaining passes are added in one step (exact, as a path's time is
-a sum).
+The walk keeps one state per robot position (the last motion), so N ``IF`` blocks in a row
+cost N steps, not 2^N paths. It runs twice: the first walk notes every segment and entry it
+meets, which are then timed in two calls of the timers (:class:`SegmentTimer`), the second adds
+them up. Long loops cost little: once a pass shifts every state by the same time and the same
+choices as the pass before it, the remaining passes are added in one step (exact, as a path's
+time is a sum). Measured (benchmarks/timing_branches.py): 40 ``IF ... ELSE`` in a row in 2.6 s,
+most of it the path solver on the 80 re-resolved moves; a ``FOR`` of 1,000,000 passes in 0.12 s.
 """
 
 from __future__ import annotations
