@@ -154,7 +154,8 @@ def _cycle_line(compiled: CompiledProgram, decimals: int, pointer: bool = True) 
     if paths is None:
         return f"{quantity(compiled.cycle_time, decimals)} s ({note})"
     if paths.shortest is None or paths.longest is None:
-        return f"{quantity(compiled.cycle_time, decimals)} s (the text in order: {paths.reason})"
+        text = quantity(compiled.cycle_time, decimals)
+        return f"{text} s (the text in order, each instruction once: {paths.reason})"
     lo, hi = quantity(paths.shortest.seconds, decimals), quantity(paths.longest.seconds, decimals)
     if paths.decided:
         how = "the path --assume names" if paths.assumed else "the only path"
@@ -281,11 +282,11 @@ def estimate_scope(compiled: CompiledProgram) -> tuple[str, str]:
         "settling at exact stops, payload and motor-torque limits, and the time of I/O and "
         "called routines beyond the fixed times"
     )
-    if compiled.paths is not None:
+    if compiled.paths is not None and compiled.paths.shortest is not None:
         excludes += (
             "; with control flow, a blend from one block into the next (across an IF, a loop's "
-            "head or end) counts as an exact stop, and the path length and the table below "
-            "follow the text, each instruction once"
+            "head or end) counts as an exact stop, and the path length and the per-instruction "
+            "times follow the text, each instruction once"
         )
     stops = sum(1 for d in compiled.diagnostics if d.kind == "zone_stop")
     if stops:

@@ -114,3 +114,27 @@ def test_time_help_explains_the_spelling(capsys: pytest.CaptureFixture[str]) -> 
         main(["time", "--help"])
     out = " ".join(capsys.readouterr().out.split())
     assert "--assume NAME=VALUE" in out and "loop:12=5" in out and "in3=true" in out
+
+
+JUMPS = """DEF jump( )
+  $VEL.CP = 0.2
+  PTP {X 500, Y -400, Z 300, A 0, B 90, C 0}
+again:
+  LIN {X 500, Y -300, Z 300, A 0, B 90, C 0}
+  IF $IN[3] THEN
+    GOTO again
+  ENDIF
+END
+"""
+
+
+def test_a_program_that_jumps_says_its_time_is_the_texts(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = tmp_path / "jump.src"
+    path.write_text(JUMPS)
+    assert main(["time", CELL, str(path), "-q"]) == 0
+    out = " ".join(capsys.readouterr().out.split())
+    assert "(the text in order, each instruction once: olp does not time the paths of a " in out
+    assert "program that jumps (GOTO at jump.src:7))" in out
+    assert "path time s" not in out and "counts as an exact stop" not in out

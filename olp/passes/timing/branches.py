@@ -613,8 +613,7 @@ def path_times(
     jump = next((n for n in leaves(program.instructions) if isinstance(n, ir.Goto)), None)
     if jump is not None:
         reason = (
-            f"the program jumps (GOTO at {_where(jump.span)}): olp gives no time per path, "
-            "only the text's in order"
+            f"olp does not time the paths of a program that jumps (GOTO at {_where(jump.span)})"
         )
         return PathTimes(None, None, given.given, reason=reason)
     env, timer = environment(program.instructions, given), SegmentTimer(compiled, options)
