@@ -60,7 +60,8 @@ def resolve_options(args: argparse.Namespace) -> ResolveOptions:
 ASSUME_HELP = (
     "what the cycle time of a program with branches and loops may take as known, repeatable: "
     "an input (in3=true, or $IN[3]=true), a variable (count=4, part.kind=#BIG, name='A'), the "
-    "passes of a loop by its source line or the label before it (loop:12=5, loop:retry=2). "
+    "passes of a loop by its source line, file and line, or the label before it (loop:12=5, "
+    "loop:sub.src:40=3, loop:retry=2). "
     "Without it, the cycle time is a range: the shortest and the longest path with the branch "
     "choices that give each; a WHILE, REPEAT or LOOP whose count is unknown counts one pass"
 )

@@ -150,6 +150,9 @@ def test_a_while_runs_the_passes_assumed_else_one(station: Station) -> None:
     assert once.notes == (
         "WHILE at t.src:3 counted as 1 pass (its count is not known: --assume loop:3=N)",
     )
+    assert ends(paths_of(station, prog, "loop:T.SRC:3=3")) == ends(three)
+    with pytest.raises(UsageError, match=r"no loop of the program is on line 3 of u\.src"):
+        paths_of(station, prog, "loop:u.src:3=3")
     never = paths_of(station, prog, "in2=false")  # the condition is known false: no pass
     assert ends(never)[0] == pytest.approx(straight(station, start(), lin(2, -300)), rel=TOL)
 

@@ -23,6 +23,7 @@ def test_every_spelling_of_an_assumption() -> None:
             "in[5]=1",
             "loop:12=5",
             "loop:Retry=0",
+            "loop:C:\\KRC\\Sub.SRC:7=2",
             "Count=4",
             "speed=2.5",
             "Part.Kind=#Big",
@@ -31,7 +32,7 @@ def test_every_spelling_of_an_assumption() -> None:
         ]
     )
     assert got.inputs == {3: True, 4: False, 5: True}
-    assert got.loops == {12: 5, "retry": 0}
+    assert got.loops == {12: 5, "retry": 0, ("sub.src", 7): 2}
     assert got.names == {
         "count": 4,
         "speed": 2.5,

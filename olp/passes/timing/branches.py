@@ -57,6 +57,7 @@ from olp.passes.timing.conditions import (
     UNKNOWN,
     Assumptions,
     Environment,
+    LoopKey,
     environment,
     expression_key,
 )
@@ -413,7 +414,7 @@ class _Walk:
         self.exits: list[States] = []
         self.done: States = {}
         self.notes: dict[tuple[str, int, int], str] = {}
-        self.used_loops: set[int | str] = set()
+        self.used_loops: set[LoopKey] = set()
 
     def all(self, nodes: Sequence[Any]) -> States:
         """The states at the end of the program ``nodes`` (its end or a return)."""
@@ -477,15 +478,17 @@ class _Walk:
 
     def passes(self, node: Any, label: str | None) -> int:
         """How many passes loop ``node`` runs (see the module docstring)."""
-        keys: list[int | str] = [node.span.line] + ([label.casefold()] if label else [])
+        file = node.span.file.replace("\\", "/").rsplit("/", 1)[-1].casefold()
+        keys: list[LoopKey] = [(file, node.span.line), node.span.line]
+        keys += [label.casefold()] if label else []
         for key in keys:
             if key in self.assumptions.loops:
                 self.used_loops.add(key)
                 count = self.assumptions.loops[key]
                 if isinstance(node, ir.Repeat) and count < 1:
+                    where = f"the REPEAT at line {node.span.line}"
                     raise UsageError(
-                        f"--assume loop:{key}={count}: the REPEAT at line {node.span.line} "
-                        "runs its body at least once"
+                        f"--assume loop:{_loop_text(key)}={count}: {where} runs at least once"
                     )
                 return count
         if isinstance(node, ir.For):
@@ -663,11 +666,19 @@ def check_assumptions(program: ir.Program, assumptions: Assumptions) -> None:
 def _check_loops_used(walk: _Walk, assumptions: Assumptions) -> None:
     for key in assumptions.loops:
         if key not in walk.used_loops:
-            raise UsageError(
-                f"--assume loop:{key}=...: no loop of the program is on line {key}"
-                if isinstance(key, int)
-                else f"--assume loop:{key}=...: no loop of the program follows label {key!r}"
-            )
+            raise UsageError(f"--assume loop:{_loop_text(key)}=...: {_no_loop(key)}")
+
+
+def _loop_text(key: LoopKey) -> str:
+    return f"{key[0]}:{key[1]}" if isinstance(key, tuple) else str(key)
+
+
+def _no_loop(key: LoopKey) -> str:
+    if isinstance(key, int):
+        return f"no loop of the program is on line {key}"
+    if isinstance(key, tuple):
+        return f"no loop of the program is on line {key[1]} of {key[0]}"
+    return f"no loop of the program follows label {key!r}"
 
 
 def _read(program: ir.Program) -> tuple[set[int], set[str]]:

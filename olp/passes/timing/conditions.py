@@ -4,9 +4,9 @@ The spelling of an assumption (vendor-neutral; case does not matter, spaces are 
 
 * ``in3=true`` or ``$IN[3]=true``: digital input 3 reads true (``true``/``false``, ``1``/``0``,
   ``on``/``off``);
-* ``loop:12=5``: the loop (``WHILE``, ``REPEAT``, ``LOOP``, or a ``FOR`` whose bounds olp
-  cannot know) whose statement is on source line 12 runs its body 5 times; ``loop:NAME=5``
-  names the loop by the label written just before it;
+* ``loop:12=5``: the loop (``WHILE``, ``REPEAT``, ``LOOP`` or ``FOR``, over its bounds) whose
+  statement is on source line 12 runs its body 5 times; ``loop:prog.src:12=5`` says which
+  file (a called routine's), ``loop:NAME=5`` names the loop by the label just before it;
 * ``NAME=VALUE``: variable ``NAME`` (a structure member ``part.kind``, an array element
   ``slot[2]``) holds ``VALUE``: ``true``/``false``, a number, ``'text'``, or an enumeration
   member ``#BASE``.
@@ -44,17 +44,20 @@ UNKNOWN: Final = _Unknown()
 
 Result = Value | _Unknown
 
+LoopKey = int | str | tuple[str, int]
+"""How an assumption names a loop: its line, its label (casefolded), or (file name, line)."""
+
 
 @dataclass(frozen=True, slots=True)
 class Assumptions:
     """What ``--assume`` says: ``inputs`` digital input number -> state; ``names`` a variable's
-    key (:func:`expression_key`) -> value; ``loops`` a loop's source line (int) or the label
-    before it (casefolded str) -> passes of its body; ``given``: the texts as the user wrote
-    them (for the summary)."""
+    key (:func:`expression_key`) -> value; ``loops`` a loop's source line (int), file name and
+    line, or the label before it (casefolded) -> passes of its body; ``given``: the texts as the
+    user wrote them (for the summary)."""
 
     inputs: Mapping[int, bool] = field(default_factory=dict)
     names: Mapping[str, Value] = field(default_factory=dict)
-    loops: Mapping[int | str, int] = field(default_factory=dict)
+    loops: Mapping[LoopKey, int] = field(default_factory=dict)
     given: tuple[str, ...] = ()
 
 
@@ -63,7 +66,7 @@ def parse_assumptions(texts: Iterable[str]) -> Assumptions:
     :class:`~olp.errors.UsageError` naming it. A later text overrides an earlier one."""
     inputs: dict[int, bool] = {}
     names: dict[str, Value] = {}
-    loops: dict[int | str, int] = {}
+    loops: dict[LoopKey, int] = {}
     given = []
     for text in texts:
         key, value = _split(text)
@@ -83,7 +86,7 @@ def _split(text: str) -> tuple[str, str]:
     key, value = "".join(key.split()), value.strip()
     if not sep or not key or not value:
         raise UsageError(f"--assume {text!r}: expected NAME=VALUE (in3=true, loop:12=5, count=4)")
-    if not all(c.isalnum() or c in "_$.[],:#" for c in key):
+    if not all(c.isalnum() or c in "_$.[],:#/\\-" for c in key):
         raise UsageError(f"--assume {text!r}: {key!r} is not a name, input or loop")
     return key, value
 
@@ -97,9 +100,12 @@ def _input_number(key: str) -> int | None:
     return int(body) if body.isdigit() else None
 
 
-def _loop_key(text: str, name: str) -> int | str:
+def _loop_key(text: str, name: str) -> LoopKey:
     if name.isdigit():
         return int(name)
+    file, colon, line = name.rpartition(":")
+    if colon and file and line.isdigit():
+        return file.replace("\\", "/").rsplit("/", 1)[-1].casefold(), int(line)
     if not name or not (name[0].isalpha() or name[0] == "_"):
         raise UsageError(f"--assume {text!r}: expected loop:LINE=N or loop:LABEL=N")
     return name.casefold()
