@@ -160,6 +160,8 @@ def test_a_while_runs_the_passes_assumed_else_one(station: Station) -> None:
 def test_a_loop_named_by_its_label(station: Station) -> None:
     loop = ir.Repeat(body=(lin(4, -300, 350), lin(5, -300)), until=IN2, span=span(3))
     prog = program(start(), lin(2, -300), ir.Label(name="Again"), loop)
+    with pytest.raises(UsageError, match="the REPEAT at line 3 runs at least once"):
+        paths_of(station, prog, "loop:again=0")
     twice = paths_of(station, prog, "loop:again=2")
     body = (lin(4, -300, 350), lin(5, -300))
     assert ends(twice)[0] == pytest.approx(
@@ -315,3 +317,11 @@ def test_a_blend_into_a_block_is_timed_as_a_stop(station: Station) -> None:
     assert taken == pytest.approx(stopped, rel=TOL) and text < stopped - 0.01
     skipped = ends(paths_of(station, prog, "in1=false"))[0]
     assert skipped == pytest.approx(straight(station, start(), fine, lin(6, -200, 400)), rel=TOL)
+
+
+def test_a_loop_left_in_its_first_pass_needs_no_count(station: Station) -> None:
+    leave = ir.If(branches=(ir.Branch(condition=IN1, body=(ir.Exit(),)),), span=span(4))
+    loop = ir.Loop(body=(lin(3, -300), leave, lin(5, -300, 400)), span=span(2))
+    left = paths_of(station, program(start(), loop), "in1=true")
+    assert left.decided and left.notes == ()
+    assert ends(left)[0] == pytest.approx(straight(station, start(), lin(3, -300)), rel=TOL)

@@ -454,8 +454,14 @@ class _Walk:
     def block(self, node: Any, states: States, label: str | None) -> States:
         if isinstance(node, ir.If | ir.Switch):
             return self.choose(node, states)
-        passes = self.passes(node, label)
-        return self.repeat(node, states, passes)
+        passes, by_rule = self.passes(node, label)
+        out, completed = self.repeat(node, states, passes)
+        if by_rule and completed:  # a path ran the pass to its end: the count mattered
+            self.notes[_key(node.span)] = (
+                f"{node.kind.upper()} at {_where(node.span)} counted as 1 pass (its count is not "
+                f"known: --assume loop:{node.span.line}=N)"
+            )
+        return out
 
     # ---- branches
 
@@ -476,8 +482,9 @@ class _Walk:
 
     # ---- loops
 
-    def passes(self, node: Any, label: str | None) -> int:
-        """How many passes loop ``node`` runs (see the module docstring)."""
+    def passes(self, node: Any, label: str | None) -> tuple[int, bool]:
+        """How many passes loop ``node`` runs (see the module docstring), and whether that is
+        the rule for a count olp does not know."""
         file = node.span.file.replace("\\", "/").rsplit("/", 1)[-1].casefold()
         keys: list[LoopKey] = [(file, node.span.line), node.span.line]
         keys += [label.casefold()] if label else []
@@ -490,21 +497,18 @@ class _Walk:
                     raise UsageError(
                         f"--assume loop:{_loop_text(key)}={count}: {where} runs at least once"
                     )
-                return count
+                return count, False
         if isinstance(node, ir.For):
             bounded = _for_count(node, self.env)
             if bounded is not None:
-                return bounded
+                return bounded, False
         if isinstance(node, ir.While) and self.env.evaluate(node.condition) is False:
-            return 0
-        word = node.kind.upper()
-        self.notes[_key(node.span)] = (
-            f"{word} at {_where(node.span)} counted as 1 pass (its count is not known: "
-            f"--assume loop:{node.span.line}=N)"
-        )
-        return 1
+            return 0, False
+        return 1, True
 
-    def repeat(self, node: Any, states: States, passes: int) -> States:
+    def repeat(self, node: Any, states: States, passes: int) -> tuple[States, bool]:
+        """The states after ``passes`` passes of loop ``node`` (or an exit during one), and
+        whether any path ran the last pass to its end."""
         start, size = self.cursor, _size(node.body)
         exits: States = {}
         self.exits.append({})
@@ -535,7 +539,7 @@ class _Walk:
                 break
         self.exits.pop()
         self.cursor = start + size
-        return _merged(current, exits)
+        return _merged(current, exits), bool(current) and passes > 0
 
 
 def _if_arms(node: ir.If, env: Environment) -> list[tuple[str, bool]]:
