@@ -275,6 +275,14 @@ def test_a_program_that_jumps_gets_no_path_time(station: Station) -> None:
     )
     paths = paths_of(station, jumping)
     assert paths.shortest is None and "GOTO at t.src:6" in paths.reason
+    notes = [
+        d.message for d in olp.compile(jumping, station).diagnostics if d.kind == "flow_timing"
+    ]
+    assert notes == [
+        "the program has control flow (first: label at line 0): olp does not time the paths of "
+        "a program that jumps (GOTO at t.src:6): its cycle time times every instruction once, "
+        "in the order of the text"
+    ]
 
 
 def test_assumptions_that_name_nothing_are_usage_errors(station: Station) -> None:
@@ -325,3 +333,28 @@ def test_a_loop_left_in_its_first_pass_needs_no_count(station: Station) -> None:
     left = paths_of(station, program(start(), loop), "in1=true")
     assert left.decided and left.notes == ()
     assert ends(left)[0] == pytest.approx(straight(station, start(), lin(3, -300)), rel=TOL)
+
+
+def test_a_toolpath_inside_a_branch_is_timed_from_each_start(station: Station) -> None:
+    ys = np.linspace(-300, -200, 21)
+    poses = np.stack([pose(y) for y in ys])
+    zones = np.full(ys.size, 0.002)
+    zones[-1] = 0.0
+    toolpath = ir.LinearPath(
+        poses=poses,
+        speeds=np.full(ys.size, 0.1),
+        zones=zones,
+        lines=np.arange(ys.size) + 10,
+    )
+    branch = ir.If(
+        branches=(ir.Branch(condition=IN1, body=(toolpath,)),),
+        orelse=(lin(5, -350),),
+        span=span(2),
+    )
+    prog = program(start(), branch, lin(7, -250, 350))
+    paths = paths_of(station, prog, "in1=true")
+    expected = straight(station, start(), toolpath, lin(7, -250, 350))
+    assert paths.decided and ends(paths)[0] == pytest.approx(expected, rel=TOL)
+    other = paths_of(station, prog, "in1=false")  # the move after the join from line 5
+    expected = straight(station, start(), lin(5, -350), lin(7, -250, 350))
+    assert ends(other)[0] == pytest.approx(expected, rel=TOL)

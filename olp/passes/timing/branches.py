@@ -733,7 +733,8 @@ def path_timing_pass(compiled: CompiledProgram, options: BuildOptions) -> Compil
     """Time a program with control flow per path (:func:`path_times`, with
     ``options.assume``) into ``compiled.paths``, with an info note that the per-instruction
     times follow the text; a program whose only path is its text (no blocks or jumps, only
-    declarations, assignments and waits) is left as it is."""
+    declarations, assignments and waits) is left as it is. Runs after the timing pass (it
+    reuses the steps' times)."""
     assumptions = getattr(options, "assume", None) or Assumptions()
     program = compiled.program
     if not program.has_flow or _one_path(program):
@@ -759,13 +760,14 @@ def _one_path(program: ir.Program) -> bool:
 def _note(compiled: CompiledProgram, paths: PathTimes) -> Diagnostic:
     first = next(n for n in leaves_and_blocks(compiled.program.instructions) if _is_flow(n))
     where = f"first: {first.kind.replace('_', ' ')} at line {first.span.line}"
+    how = (
+        f"{paths.reason}: its cycle time times every instruction once, in the order of the text"
+        if paths.shortest is None
+        else "its cycle time is given per path (the summary's range); the time of each "
+        "instruction follows the text, each instruction once"
+    )
     return Diagnostic(
-        "info",
-        "flow_timing",
-        f"the program has control flow ({where}): its cycle time is given per path (the "
-        "summary's range); the time of each instruction follows the text, each instruction "
-        "once",
-        first.span,
+        "info", "flow_timing", f"the program has control flow ({where}): {how}", first.span
     )
 
 
