@@ -13,6 +13,11 @@ own trajectory CSV, or a UR RTDE recording) and writes them as a station overrid
 without ``--output``), with the residual of re-timing the recording with them
 (:mod:`olp.passes.timing.calibrate`).
 
+A program with branches and loops is timed per path: the shortest and the longest path, with
+the branch choices that give each, or the path ``--assume`` names (inputs ``in3=true``,
+variables ``count=4``, loop passes ``loop:12=5``; :mod:`olp.passes.timing.branches`). The table
+per instruction and the trajectory follow the text, each instruction once.
+
 Exit codes as for ``olp build``: 0 timed, 1 the program has errors, 2 bad input.
 """
 
@@ -26,13 +31,13 @@ from typing import TYPE_CHECKING
 
 from olp.commands.common import EXIT_OK, EXIT_PROGRAM_ERRORS, print_diagnostics, require_files
 from olp.commands.options import (
+    add_assume_option,
     add_check_options,
     add_collision_options,
     add_program,
     add_program_options,
-    collision_options,
+    build_options,
     parse_program,
-    resolve_options,
 )
 from olp.errors import UsageError
 
@@ -89,6 +94,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="time charged for an instruction kind (set_output, wait_input, call, comment) or a "
         "named call (call:NAME); repeatable, e.g. --time call:SprayOn=1.5",
     )
+    add_assume_option(parser)
     add_check_options(parser)
     add_collision_options(parser)
     add_program_options(parser)
@@ -109,6 +115,7 @@ def run(args: argparse.Namespace) -> int:
     linear = _speed_list(args.sweep_linear, "--sweep-linear", "mm/s", 1e-3)
     joint = _speed_list(args.sweep_joint, "--sweep-joint", "%", 1e-2, upper=1.0)
     other_times = parse_times(args.time)
+    options = build_options(args, other_times)
     if not (math.isfinite(args.dt) and args.dt > 0):
         raise UsageError(f"--dt must be a positive number of seconds, got {args.dt}")
     _check_paths(args)
@@ -120,13 +127,7 @@ def run(args: argparse.Namespace) -> int:
     with progress.showing(progress.terminal_reporter(args.quiet)):
         with progress.stage("read"):
             parsed = parse_program(args, station)
-        compiled = compile(
-            parsed.program,
-            station,
-            resolve_options(args),
-            collisions=collision_options(args),
-            other_times=other_times,
-        )
+        compiled = compile(parsed.program, station, options)
     print_diagnostics(parsed.notes + compiled.diagnostics, args.program, quiet=args.quiet)
     if not compiled.ok:
         return EXIT_PROGRAM_ERRORS
