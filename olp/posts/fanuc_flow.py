@@ -1,0 +1,862 @@
+"""LS spelling of :mod:`olp.ir_flow`: blocks lowered to labels and jumps, variables in registers.
+
+The LS post (:mod:`olp.posts.fanuc`) walks a file's steps with the block markers of
+:mod:`olp.posts.flow` woven in; :func:`lower` turns that stream into ``/MN`` lines (unnumbered:
+the template numbers them), one list per step, and collects what LS cannot express as located
+problems. Nothing here is a guess: what could not be verified is an error naming the line.
+
+Conventions and their sources (public LS exports of R-30iA/R-30iB controllers found by text
+search, FANUC America's *Advanced TP Programming* course chapter 7 "Mixed logic" and the
+FOR/ENDFOR chapter of a FANUC operator manual, both as stored public pages; pinned by
+``tests/posts/test_fanuc_flow.py``):
+
+* Jumps: ``LBL[n]`` and ``JMP LBL[n]``; a label may carry a comment, ``LBL[1:BEGIN]`` (exports).
+  Program labels are numbered 1, 2, ... in order of appearance with their name as the comment
+  (only letters, digits and ``_``, at most :data:`COMMENT_CHARS` characters: the comment limit
+  is unverified, 16 is the longest olp writes); labels olp makes for blocks take the numbers
+  after them, so the two never collide.
+* ``IF <condition>,JMP LBL[n]`` (exports: ``IF R[10]<170 ...,JMP LBL[1]``). An ``if``/``elif``
+  block jumps over its body on the negated condition (comparisons flipped, De Morgan for AND/OR:
+  exact for numbers and inputs, so no ``!`` operator is needed); ``else`` bodies follow a
+  ``JMP`` to the end label. ``while`` is a label, a negated test and a ``JMP`` back;
+  ``repeat``/``until`` jumps back on the negated condition; ``loop`` jumps back for ever; ``exit``
+  jumps to the innermost loop's end label.
+* Conditions: *standard logic* (no option) writes one comparison or up to
+  :data:`STANDARD_CONDITIONS` comparisons joined by only ``AND`` or only ``OR`` (course: "in
+  standard logic a maximum of five logical conditions"; exports: ``IF DI[3]=ON AND DI[4]=ON,``),
+  each ``register op value`` with ``op`` one of ``= <> < <= > >=`` and the value a register or a
+  non-negative constant. Anything else needs *mixed logic* (course: AND and OR together,
+  arithmetic, ``!`` and parentheses, up to :data:`MIXED_CONDITIONS` conditions), written only when
+  the post option ``mixed_logic: true`` says the controller has it: the whole condition or value
+  in parentheses, every nested operation parenthesised so no priority rule is relied on
+  (exports: ``IF (R[10]<170 OR R[10]>400),JMP``, ``R[87]=(R[87]+1)``, ``PR[10001,3]=(-50)``).
+* ``SELECT R[i]=v,JMP LBL[a] ;`` then one line ``=w,JMP LBL[b] ;`` per further value and
+  ``ELSE,JMP LBL[c] ;`` (exports; each a numbered line). The subject must be a numeric
+  variable, the values integer constants.
+* ``FOR R[i]=start TO stop ;`` / ``DOWNTO`` and ``ENDFOR ;`` (manual: the counter is a register,
+  start and stop a constant, ``R[]`` or ``AR[]``, constants integers -32767..32766; TO counts by
+  1, DOWNTO by -1; exports ``FOR R[20]=52 TO 80 ;``). Another step is an error. Whether a jump may
+  leave a FOR/ENDFOR region is not verified: ``exit`` or ``goto`` out of a FOR is an error.
+* ``WAIT <condition> ;`` (exports ``WAIT DI[806]=ON AND DI[807]=OFF``, ``WAIT (DI[49] AND
+  DI[51])``); ``END ;`` ends the program (olp inlines routines, so a return ends it).
+* Registers (:class:`Registers`): numeric variables (``BOOL``, ``INT``, ``REAL``) in ``R[n]``,
+  positions (``FRAME``, ``POS``, ``E6POS``: Cartesian; ``AXIS``, ``E6AXIS``: joints) in
+  ``PR[n]``, numbered in declaration order from the post options ``registers`` and
+  ``position_registers`` (default ``[101, 200]`` and ``[51, 100]``: the upper halves of the 200
+  R and 100 PR a controller has by default, medium confidence), an array taking consecutive
+  registers; references carry the name as their comment, ``R[101:nCount]`` (exports). A
+  ``BOOL`` holds 1 (TRUE) or 0 (FALSE) and is tested as ``R[n]=1``. Position components are
+  ``PR[n,j]``, j = 1..6 for X, Y, Z, W, P, R (a public cheat sheet; exports ``PR[1,3]=PR[1,3]``);
+  KRL's A, B, C are Fanuc's R, P, W (both Rz(A)·Ry(B)·Rx(C), :mod:`olp.vendors.fanuc`), joint
+  components A1..A6 are j = 1..6. Text variables (``CHAR``): string registers exist only on
+  some controllers and could not be verified, so using one is an error.
+* Arithmetic: ``R[i]=a op b`` with one of ``+ - * /`` in standard logic; KRL divides two INTs
+  with truncation and rounds a REAL assigned to an INT, which LS does not: both are errors.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+from olp import ir
+from olp.posts.numbers import NumberError, NumberFormat, format_number
+
+STANDARD_CONDITIONS = 5
+"""Comparisons in one standard-logic condition (FANUC America course, mixed logic chapter)."""
+MIXED_CONDITIONS = 20
+"""Comparisons in one mixed-logic condition (same source: "up to twenty ... depending on the
+data type"; olp counts every comparison and input)."""
+COMMENT_CHARS = 16
+"""Characters of a label or register comment olp writes (unverified bound; names are cut)."""
+FOR_RANGE = (-32767, 32766)
+"""Constants a FOR instruction takes (FANUC manual, FOR/ENDFOR chapter)."""
+DEFAULT_REGISTERS = (101, 200)
+DEFAULT_POSITION_REGISTERS = (51, 100)
+
+NUMERIC_TYPES = {"BOOL": "bool", "INT": "int", "REAL": "real"}
+POSITION_TYPES = {
+    "FRAME": "cartesian",
+    "POS": "cartesian",
+    "E6POS": "cartesian",
+    "AXIS": "joint",
+    "E6AXIS": "joint",
+}
+CARTESIAN_FIELDS = {"X": 1, "Y": 2, "Z": 3, "C": 4, "B": 5, "A": 6}
+"""KRL component -> ``PR[n,j]`` (C is W about X, B is P about Y, A is R about Z)."""
+JOINT_FIELDS = {f"A{k}": k for k in range(1, 7)}
+
+REGISTER_VALUE = NumberFormat("register value", "", 6, storage="real32", compact=True)
+"""Constants: fixed point, trailing zeros dropped, held by a 32-bit REAL to 5e-7 (the registers'
+storage, medium confidence)."""
+
+_COMPARE = {"==": "=", "<>": "<>", "<": "<", "<=": "<=", ">": ">", ">=": ">="}
+_NEGATED = {"=": "<>", "<>": "=", "<": ">=", "<=": ">", ">": "<=", ">=": "<"}
+_MIRRORED = {"=": "=", "<>": "<>", "<": ">", "<=": ">=", ">": "<", ">=": "<="}
+_ARITHMETIC = {"+", "-", "*", "/"}
+_STATES = {"ON": "OFF", "OFF": "ON"}
+_MARKERS = frozenset(
+    {"if", "elif", "else", "end_if", "switch", "case", "default", "end_switch", "while"}
+    | {"end_while", "repeat", "until", "loop", "end_loop", "for", "end_for"}
+)
+FLOW_KINDS = _MARKERS | {"declare", "assign", "wait_until", "label", "goto", "exit", "return"}
+"""Step kinds whose lines :func:`lower` writes."""
+
+
+class Unwritable(Exception):
+    """A statement LS cannot express; the message says what, the node where."""
+
+    def __init__(self, message: str, node: Any) -> None:
+        super().__init__(message)
+        self.node = node
+
+
+def comment(name: str) -> str:
+    """A name as an LS register or label comment: letters, digits and ``_`` only, cut to
+    :data:`COMMENT_CHARS` (user text never reaches the line otherwise)."""
+    return re.sub(r"[^A-Za-z0-9_]", "", name)[:COMMENT_CHARS]
+
+
+def _tagged(base: str, number: int, name: str) -> str:
+    text = comment(name)
+    return f"{base}[{number}:{text}]" if text else f"{base}[{number}]"
+
+
+# --------------------------------------------------------------------------------------------
+# Registers
+
+
+@dataclass(frozen=True, slots=True)
+class Variable:
+    """A program variable in registers: ``kind`` (bool, int, real, cartesian, joint), the
+    first register ``number`` and ``size`` (array elements, 1 for a scalar)."""
+
+    name: str
+    kind: str
+    number: int
+    size: int = 1
+
+    @property
+    def position(self) -> bool:
+        return self.kind in ("cartesian", "joint")
+
+    def ref(self, element: int = 1) -> str:
+        """``R[n:name]`` / ``PR[n:name]`` of element ``element`` (1-based)."""
+        base = "PR" if self.position else "R"
+        label = self.name if self.size == 1 else f"{self.name}_{element}"
+        return _tagged(base, self.number + element - 1, label)
+
+
+@dataclass
+class Registers:
+    """Register allocation in declaration order within the post options' ranges."""
+
+    ranges: Mapping[str, tuple[int, int]]
+    variables: dict[str, Variable] = field(default_factory=dict)
+    skipped: dict[str, ir.Declare] = field(default_factory=dict)
+    next: dict[str, int] = field(default_factory=dict)
+
+    def declare(self, decl: ir.Declare) -> Variable | None:
+        """Allocate ``decl``; None for a type LS has no register for (noted in ``skipped``)."""
+        key = decl.name.upper()
+        if key in self.variables:
+            return self.variables[key]
+        type_name = decl.type_name.upper()
+        kind = NUMERIC_TYPES.get(type_name) or POSITION_TYPES.get(type_name)
+        if kind is None:
+            self.skipped[key] = decl
+            return None
+        size = _array_size(decl)
+        bank = "position_registers" if kind in ("cartesian", "joint") else "registers"
+        low, high = self.ranges[bank]
+        number = self.next.get(bank, low)
+        if number + size - 1 > high:
+            raise Unwritable(
+                f"{decl.name} needs {size} register(s) beyond the option {bank} [{low}, {high}]",
+                decl,
+            )
+        self.next[bank] = number + size
+        self.variables[key] = var = Variable(decl.name, kind, number, size)
+        return var
+
+    def lookup(self, name: str, node: Any) -> Variable:
+        var = self.variables.get(name.upper())
+        if var is not None:
+            return var
+        if name.upper() in self.skipped:
+            what = self.skipped[name.upper()].type_name.upper()
+            reason = (
+                "text variables would need string registers (SR[]), which only some "
+                "controllers have and olp could not verify"
+                if what in ("CHAR", "STRING")
+                else "LS has no registers for that type"
+            )
+            raise Unwritable(f"{name} is a {what}: {reason}", node)
+        raise Unwritable(
+            f"{name} is not declared in the program: olp cannot tell whether it is a number or "
+            "a position, nor which register holds it on the controller",
+            node,
+        )
+
+
+def _array_size(decl: ir.Declare) -> int:
+    if not decl.dims:
+        return 1
+    if len(decl.dims) != 1 or not _int_constant(decl.dims[0]):
+        raise Unwritable(f"{decl.name}: only one-dimensional arrays of constant size", decl)
+    size = int(decl.dims[0].value)  # type: ignore[union-attr]
+    if size < 1:
+        raise Unwritable(f"{decl.name}: array size {size}", decl)
+    return size
+
+
+def _int_constant(expr: Any) -> bool:
+    return (
+        isinstance(expr, ir.Constant)
+        and isinstance(expr.value, int)
+        and not isinstance(expr.value, bool)
+    )
+
+
+def register_ranges(options: Mapping[str, Any]) -> dict[str, tuple[int, int]]:
+    """The option ranges ``registers`` and ``position_registers`` as (first, last)."""
+    out = {}
+    for key, default in (
+        ("registers", DEFAULT_REGISTERS),
+        ("position_registers", DEFAULT_POSITION_REGISTERS),
+    ):
+        low, high = (int(v) for v in options.get(key, default))
+        out[key] = (low, high)
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# Conditions: trees of AND/OR over comparisons, negated by De Morgan
+
+
+@dataclass(frozen=True, slots=True)
+class Compare:
+    """``left op right`` as LS text; ``standard``: writable in standard logic."""
+
+    left: str
+    op: str
+    right: str
+    standard: bool
+
+    def negated(self) -> Compare:
+        if self.right in _STATES and self.op == "=":  # a digital input has two states
+            return Compare(self.left, "=", _STATES[self.right], self.standard)
+        return Compare(self.left, _NEGATED[self.op], self.right, self.standard)
+
+    def text(self) -> str:
+        return f"{self.left}{self.op}{self.right}"
+
+
+@dataclass(frozen=True, slots=True)
+class Logic:
+    op: str  # "AND" or "OR"
+    parts: tuple[Any, ...]
+
+    def negated(self) -> Logic:
+        return Logic("OR" if self.op == "AND" else "AND", tuple(p.negated() for p in self.parts))
+
+
+Condition = Compare | Logic
+
+
+def _count(cond: Condition) -> int:
+    return 1 if isinstance(cond, Compare) else sum(_count(p) for p in cond.parts)
+
+
+def _flat(cond: Condition) -> Condition:
+    """Nested AND in AND (OR in OR) made one chain."""
+    if isinstance(cond, Compare):
+        return cond
+    parts: list[Any] = []
+    for part in (_flat(p) for p in cond.parts):
+        if isinstance(part, Logic) and part.op == cond.op:
+            parts.extend(part.parts)
+        else:
+            parts.append(part)
+    return Logic(cond.op, tuple(parts))
+
+
+def _mixed_text(cond: Condition, top: bool = True) -> str:
+    if isinstance(cond, Compare):
+        return cond.text()
+    text = f" {cond.op} ".join(_mixed_text(p, False) for p in cond.parts)
+    return text if top else f"({text})"
+
+
+# --------------------------------------------------------------------------------------------
+# The lowering
+
+
+@dataclass
+class _Frame:
+    kind: str
+    node: Any
+    top: int | None = None
+    end: int | None = None
+    next: int | None = None
+    cases: list[int] = field(default_factory=list)
+    default: int | None = None
+    for_id: int = 0
+
+
+class Lowering:
+    """The ``/MN`` lines of a file's steps (:func:`lower`)."""
+
+    def __init__(self, options: Mapping[str, Any], events: Sequence[tuple[str, Any]]) -> None:
+        self.mixed = bool(options.get("mixed_logic", False))
+        self.registers = Registers(register_ranges(options))
+        self.stack: list[_Frame] = []
+        self.labels, self.label_fors = self._program_labels(events)
+        self.next_label = len(self.labels) + 1
+        self.seen_labels: set[str] = set()
+        self.for_count = 0
+
+    # -- labels ------------------------------------------------------------------------------
+
+    @staticmethod
+    def _program_labels(
+        events: Sequence[tuple[str, Any]],
+    ) -> tuple[dict[str, int], dict[str, tuple[int, ...]]]:
+        """Program labels numbered in order of appearance, and the FOR blocks around each."""
+        labels: dict[str, int] = {}
+        around: dict[str, tuple[int, ...]] = {}
+        fors: list[int] = []
+        count = 0
+        for kind, node in events:
+            if kind == "for":
+                count += 1
+                fors.append(count)
+            elif kind == "end_for":
+                fors.pop()
+            elif kind == "label":
+                key = node.name.upper()
+                labels.setdefault(key, len(labels) + 1)
+                around.setdefault(key, tuple(fors))
+        return labels, around
+
+    def label(self) -> int:
+        self.next_label += 1
+        return self.next_label - 1
+
+    # -- statements --------------------------------------------------------------------------
+
+    def lines(self, kind: str, node: Any) -> list[str]:
+        handler = getattr(self, "_" + kind)
+        out: list[str] = handler(node)
+        return out
+
+    def _declare(self, decl: ir.Declare) -> list[str]:
+        var = self.registers.declare(decl)
+        if var is None or decl.value is None:
+            return []
+        if var.position:
+            raise Unwritable(
+                f"the initial value of {decl.name}: LS cannot write a position value into a "
+                "position register in one line",
+                decl,
+            )
+        return self._store(var.ref(), var.kind, decl.value, decl)
+
+    def _assign(self, node: ir.Assign) -> list[str]:
+        target = node.target
+        if isinstance(target, ir.Name):
+            var = self.registers.lookup(target.name, node)
+            if var.size != 1:
+                raise Unwritable(f"{target.name} is an array: assign its elements", node)
+            if var.position:
+                return [f"  {var.ref()}={self._position_value(var, node.value, node)} ;"]
+            return self._store(var.ref(), var.kind, node.value, node)
+        ref, kind = self._operand_ref(target, node)
+        return self._store(ref, kind, node.value, node)
+
+    def _position_value(self, var: Variable, value: Any, node: Any) -> str:
+        if isinstance(value, ir.Name):
+            other = self.registers.lookup(value.name, node)
+            if other.position and other.kind == var.kind and other.size == 1:
+                return other.ref()
+        raise Unwritable(
+            f"{var.name} = ...: LS copies a position register only from another of the same "
+            "representation (PR[i]=PR[j]); set its components one by one",
+            node,
+        )
+
+    def _store(self, ref: str, kind: str, value: Any, node: Any) -> list[str]:
+        if kind == "bool":
+            return [f"  {ref}={self._bool_value(value, node)} ;"]
+        vtype = self._type(value, node)
+        if vtype == "bool":
+            raise Unwritable("a condition's result cannot be stored in a number register", node)
+        if kind == "int" and vtype == "real":
+            raise Unwritable(
+                "a REAL value assigned to an INT: KRL rounds it, an LS register would keep the "
+                "fraction",
+                node,
+            )
+        return [f"  {ref}={self._value(value, node)} ;"]
+
+    def _bool_value(self, value: Any, node: Any) -> str:
+        if isinstance(value, ir.Constant) and isinstance(value.value, bool):
+            return "1" if value.value else "0"
+        if isinstance(value, ir.Name):
+            var = self.registers.lookup(value.name, node)
+            if var.kind == "bool" and var.size == 1:
+                return var.ref()
+        raise Unwritable(
+            "a BOOL variable is written only TRUE, FALSE or another BOOL: what LS stores for a "
+            "condition's result is not verified",
+            node,
+        )
+
+    def _wait_until(self, node: ir.WaitUntil) -> list[str]:
+        return [f"  WAIT {self._condition(node.condition, node)} ;"]
+
+    def _label(self, node: ir.Label) -> list[str]:
+        key = node.name.upper()
+        if key in self.seen_labels:
+            raise Unwritable(f"label {node.name} appears twice (a routine inlined twice?)", node)
+        self.seen_labels.add(key)
+        return [f"  {_tagged('LBL', self.labels[key], node.name)} ;"]
+
+    def _goto(self, node: ir.Goto) -> list[str]:
+        key = node.label.upper()
+        if key not in self.labels:
+            raise Unwritable(f"GOTO {node.label}: no such label in the program", node)
+        here = tuple(f.for_id for f in self.stack if f.kind == "for")
+        if self.label_fors[key] != here:
+            raise Unwritable(
+                f"GOTO {node.label} crosses a FOR/ENDFOR boundary: whether LS allows a jump "
+                "into or out of FOR/ENDFOR is not verified",
+                node,
+            )
+        return [f"  JMP LBL[{self.labels[key]}] ;"]
+
+    def _exit(self, node: ir.Exit) -> list[str]:
+        loops = [f for f in self.stack if f.kind in ("while", "repeat", "loop", "for")]
+        if not loops:
+            raise Unwritable("EXIT outside a loop", node)
+        frame = loops[-1]
+        if frame.kind == "for":
+            raise Unwritable(
+                "EXIT from a FOR loop: whether LS allows a jump out of FOR/ENDFOR is not verified",
+                node,
+            )
+        if frame.end is None:
+            frame.end = self.label()
+        return [f"  JMP LBL[{frame.end}] ;"]
+
+    def _return(self, node: ir.Return) -> list[str]:
+        return ["  END ;"]
+
+    # -- blocks ------------------------------------------------------------------------------
+
+    def _jump_unless(self, condition: Any, target: int, node: Any) -> str:
+        text = self._condition(condition, node, negate=True)
+        return f"  IF {text},JMP LBL[{target}] ;"
+
+    def _if(self, node: ir.If) -> list[str]:
+        frame = _Frame("if", node, end=None, next=self.label())
+        self.stack.append(frame)
+        return [self._jump_unless(node.branches[0].condition, frame.next, node)]  # type: ignore[arg-type]
+
+    def _elif(self, branch: ir.Branch) -> list[str]:
+        frame = self.stack[-1]
+        if frame.end is None:
+            frame.end = self.label()
+        out = [f"  JMP LBL[{frame.end}] ;", f"  LBL[{frame.next}] ;"]
+        frame.next = self.label()
+        return [*out, self._jump_unless(branch.condition, frame.next, branch)]
+
+    def _else(self, node: ir.If) -> list[str]:
+        frame = self.stack[-1]
+        if frame.end is None:
+            frame.end = self.label()
+        out = [f"  JMP LBL[{frame.end}] ;", f"  LBL[{frame.next}] ;"]
+        frame.next = None
+        return out
+
+    def _end_if(self, node: ir.If) -> list[str]:
+        frame = self.stack.pop()
+        out = [] if frame.next is None else [f"  LBL[{frame.next}] ;"]
+        return out + ([] if frame.end is None else [f"  LBL[{frame.end}] ;"])
+
+    def _switch(self, node: ir.Switch) -> list[str]:
+        frame = _Frame("switch", node, end=None)
+        frame.cases = [self.label() for _ in node.cases]
+        frame.default = self.label() if node.default else None
+        self.stack.append(frame)
+        subject = node.subject
+        var = self.registers.lookup(subject.name, node) if isinstance(subject, ir.Name) else None
+        if var is None or var.kind not in ("int", "real") or var.size != 1:
+            raise Unwritable("SELECT takes a numeric variable (a register) as its subject", node)
+        out: list[str] = []
+        for case, target in zip(node.cases, frame.cases, strict=True):
+            for value in case.values:
+                v = _folded(value)
+                if not isinstance(v, int) or isinstance(v, bool) or v < 0:
+                    raise Unwritable(
+                        "SELECT compares with non-negative integer constants only (negative "
+                        "values are not verified)",
+                        case,
+                    )
+                head = f"  SELECT {var.ref()}" if not out else "       "
+                out.append(f"{head}={self._constant(v, case)},JMP LBL[{target}] ;")
+        if not out:
+            raise Unwritable("a SWITCH without cases", node)
+        otherwise = frame.default if frame.default is not None else self._end(frame)
+        return [*out, f"       ELSE,JMP LBL[{otherwise}] ;"]
+
+    def _end(self, frame: _Frame) -> int:
+        if frame.end is None:
+            frame.end = self.label()
+        return frame.end
+
+    def _case(self, case: ir.Case) -> list[str]:
+        frame = self.stack[-1]
+        k = next(i for i, c in enumerate(frame.node.cases) if c is case)
+        lead = [f"  JMP LBL[{self._end(frame)}] ;"] if k > 0 else []
+        return [*lead, f"  LBL[{frame.cases[k]}] ;"]
+
+    def _default(self, node: ir.Switch) -> list[str]:
+        frame = self.stack[-1]
+        lead = [f"  JMP LBL[{self._end(frame)}] ;"] if node.cases else []
+        return [*lead, f"  LBL[{frame.default}] ;"]
+
+    def _end_switch(self, node: ir.Switch) -> list[str]:
+        frame = self.stack.pop()
+        return [] if frame.end is None else [f"  LBL[{frame.end}] ;"]
+
+    def _loop_head(self, kind: str, node: Any) -> _Frame:
+        frame = _Frame(kind, node, top=self.label())
+        self.stack.append(frame)
+        return frame
+
+    def _while(self, node: ir.While) -> list[str]:
+        frame = self._loop_head("while", node)
+        frame.end = self.label()
+        return [f"  LBL[{frame.top}] ;", self._jump_unless(node.condition, frame.end, node)]
+
+    def _end_while(self, node: ir.While) -> list[str]:
+        frame = self.stack.pop()
+        return [f"  JMP LBL[{frame.top}] ;", f"  LBL[{frame.end}] ;"]
+
+    def _repeat(self, node: ir.Repeat) -> list[str]:
+        return [f"  LBL[{self._loop_head('repeat', node).top}] ;"]
+
+    def _until(self, node: ir.Repeat) -> list[str]:
+        frame = self.stack.pop()
+        out = [self._jump_unless(node.until, frame.top, node)]  # type: ignore[arg-type]
+        return out + ([] if frame.end is None else [f"  LBL[{frame.end}] ;"])
+
+    def _loop(self, node: ir.Loop) -> list[str]:
+        return [f"  LBL[{self._loop_head('loop', node).top}] ;"]
+
+    def _end_loop(self, node: ir.Loop) -> list[str]:
+        frame = self.stack.pop()
+        out = [f"  JMP LBL[{frame.top}] ;"]
+        return out + ([] if frame.end is None else [f"  LBL[{frame.end}] ;"])
+
+    def _for(self, node: ir.For) -> list[str]:
+        self.for_count += 1
+        self.stack.append(_Frame("for", node, for_id=self.for_count))
+        var = self.registers.lookup(node.variable, node)
+        if var.kind != "int" or var.size != 1:
+            raise Unwritable(f"FOR counter {node.variable} must be an INT variable", node)
+        step = 1 if node.step is None else _folded(node.step)
+        if step == 1 and not isinstance(step, bool):
+            direction = "TO"
+        elif step == -1 and not isinstance(step, bool):
+            direction = "DOWNTO"
+        else:
+            raise Unwritable("LS FOR counts by 1 (TO) or -1 (DOWNTO) only", node)
+        start, stop = self._for_bound(node.start, node), self._for_bound(node.stop, node)
+        return [f"  FOR {var.ref()}={start} {direction} {stop} ;"]
+
+    def _for_bound(self, expr: Any, node: Any) -> str:
+        value = _folded(expr)
+        if isinstance(value, int) and not isinstance(value, bool):
+            if not FOR_RANGE[0] <= value <= FOR_RANGE[1]:
+                raise Unwritable(f"FOR bound {value} is outside {FOR_RANGE}", node)
+            return str(value)
+        if isinstance(expr, ir.Name):
+            var = self.registers.lookup(expr.name, node)
+            if var.kind == "int" and var.size == 1:
+                return var.ref()
+        raise Unwritable(
+            "a FOR bound must be an integer constant or an INT variable (FOR takes a constant, "
+            "R[] or AR[])",
+            node,
+        )
+
+    def _end_for(self, node: ir.For) -> list[str]:
+        self.stack.pop()
+        return ["  ENDFOR ;"]
+
+    # -- expressions -------------------------------------------------------------------------
+
+    def _type(self, expr: Any, node: Any) -> str:
+        """bool, int or real."""
+        if isinstance(expr, ir.Constant):
+            v = expr.value
+            if isinstance(v, bool):
+                return "bool"
+            if isinstance(v, int):
+                return "int"
+            if isinstance(v, float):
+                return "real"
+            raise Unwritable(f"the text {v!r}: LS registers hold numbers", node)
+        if isinstance(expr, ir.Name | ir.Index | ir.Member):
+            return self._operand_ref(expr, node)[1]
+        if isinstance(expr, ir.UnaryOp) and expr.op in ("-", "+"):
+            return self._type(expr.operand, node)
+        if isinstance(expr, ir.BinaryOp) and expr.op in _ARITHMETIC:
+            left, right = self._type(expr.left, node), self._type(expr.right, node)
+            if "bool" in (left, right):
+                raise Unwritable(f"arithmetic on a BOOL ({expr.op})", node)
+            if expr.op == "/" and left == right == "int":
+                raise Unwritable(
+                    "KRL divides two INTs with truncation; LS's / does not (and the rounding "
+                    "of its DIV for negative values is not verified)",
+                    node,
+                )
+            return "real" if "real" in (left, right) else "int"
+        if isinstance(expr, ir.BinaryOp | ir.UnaryOp | ir.DigitalInput):
+            return "bool"
+        raise Unwritable(f"{_describe(expr)} cannot be written in LS", node)
+
+    def _operand_ref(self, expr: Any, node: Any) -> tuple[str, str]:
+        """A register reference and its value type (bool, int, real)."""
+        if isinstance(expr, ir.Name):
+            var = self.registers.lookup(expr.name, node)
+            if var.position or var.size != 1:
+                raise Unwritable(f"{expr.name} is not a single number", node)
+            return var.ref(), var.kind
+        if isinstance(expr, ir.Index) and isinstance(expr.base, ir.Name):
+            var = self.registers.lookup(expr.base.name, node)
+            if var.position or var.size == 1 or len(expr.indices) != 1:
+                raise Unwritable(f"{expr.base.name}[...] is not an array of numbers", node)
+            k = _folded(expr.indices[0])
+            if not isinstance(k, int) or isinstance(k, bool):
+                raise Unwritable(
+                    f"{expr.base.name}[...]: an index that is not a constant needs indirect "
+                    "register arithmetic LS cannot write in one reference",
+                    node,
+                )
+            if not 1 <= k <= var.size:
+                raise Unwritable(f"{expr.base.name}[{k}] is outside 1..{var.size}", node)
+            return var.ref(k), var.kind
+        if isinstance(expr, ir.Member) and isinstance(expr.base, ir.Name):
+            var = self.registers.lookup(expr.base.name, node)
+            fields = CARTESIAN_FIELDS if var.kind == "cartesian" else JOINT_FIELDS
+            j = fields.get(expr.field.upper()) if var.position and var.size == 1 else None
+            if j is None:
+                raise Unwritable(
+                    f"{expr.base.name}.{expr.field}: no position register component", node
+                )
+            return f"PR[{var.number},{j}]", "real"
+        raise Unwritable(f"{_describe(expr)} cannot be written in LS", node)
+
+    def _value(self, expr: Any, node: Any) -> str:
+        """A numeric value: standard ``a``, ``a op b``; else ``(...)`` with mixed logic."""
+        standard = self._standard_value(expr, node)
+        if standard is not None:
+            return standard
+        self._need_mixed(node, "this arithmetic")
+        return f"({self._mixed_value(expr, node)})"
+
+    def _standard_value(self, expr: Any, node: Any) -> str | None:
+        simple = self._simple(expr, node)
+        if simple is not None:
+            return simple
+        if isinstance(expr, ir.BinaryOp) and expr.op in _ARITHMETIC:
+            left, right = self._simple(expr.left, node), self._simple(expr.right, node)
+            if left is not None and right is not None:
+                return f"{left}{expr.op}{right}"
+        return None
+
+    def _simple(self, expr: Any, node: Any) -> str | None:
+        """A register or a non-negative constant (standard logic operands), else None."""
+        value = _folded(expr)
+        if isinstance(value, int | float) and not isinstance(value, bool):
+            return self._constant(value, node) if value >= 0 else None
+        if isinstance(expr, ir.Name | ir.Index | ir.Member):
+            return self._operand_ref(expr, node)[0]
+        return None
+
+    def _mixed_value(self, expr: Any, node: Any) -> str:
+        value = _folded(expr)
+        if isinstance(value, int | float) and not isinstance(value, bool):
+            return self._constant(value, node)
+        if isinstance(expr, ir.Name | ir.Index | ir.Member):
+            return self._operand_ref(expr, node)[0]
+        if isinstance(expr, ir.UnaryOp) and expr.op == "+":
+            return self._mixed_value(expr.operand, node)
+        if isinstance(expr, ir.BinaryOp) and expr.op in _ARITHMETIC:
+            self._type(expr, node)
+            left = self._nested(expr.left, node)
+            right = self._nested(expr.right, node)
+            return f"{left}{expr.op}{right}"
+        raise Unwritable(f"{_describe(expr)} cannot be written in LS", node)
+
+    def _nested(self, expr: Any, node: Any) -> str:
+        text = self._mixed_value(expr, node)
+        return f"({text})" if isinstance(expr, ir.BinaryOp) else text
+
+    def _constant(self, value: float, node: Any) -> str:
+        try:
+            return format_number(value, REGISTER_VALUE)
+        except NumberError as exc:
+            raise Unwritable(str(exc), node) from None
+
+    def _need_mixed(self, node: Any, what: str) -> None:
+        if not self.mixed:
+            raise Unwritable(
+                f"{what} needs LS mixed logic (AND with OR, arithmetic in a condition, "
+                "parentheses, negative constants, more than one operator); set the post option "
+                "mixed_logic: true if the controller has it",
+                node,
+            )
+
+    def _condition(self, expr: Any, node: Any, negate: bool = False) -> str:
+        cond = _flat(self._cond(expr, node, negate))
+        if _standard(cond):
+            return _mixed_text(cond)
+        self._need_mixed(node, "this condition")
+        if _count(cond) > MIXED_CONDITIONS:
+            raise Unwritable(
+                f"the condition has {_count(cond)} comparisons; LS mixed logic takes at most "
+                f"{MIXED_CONDITIONS}",
+                node,
+            )
+        return f"({_mixed_text(cond)})"
+
+    def _cond(self, expr: Any, node: Any, negate: bool) -> Condition:
+        if isinstance(expr, ir.UnaryOp) and expr.op == "not":
+            return self._cond(expr.operand, node, not negate)
+        if isinstance(expr, ir.BinaryOp) and expr.op in ("and", "or"):
+            parts = (self._cond(expr.left, node, False), self._cond(expr.right, node, False))
+            logic = Logic(expr.op.upper(), parts)
+            return logic.negated() if negate else logic
+        atom = self._atom(expr, node)
+        return atom.negated() if negate else atom
+
+    def _atom(self, expr: Any, node: Any) -> Compare:
+        if isinstance(expr, ir.DigitalInput):
+            return Compare(f"DI[{expr.index}]", "=", "ON", True)
+        if isinstance(expr, ir.Name):
+            ref, kind = self._operand_ref(expr, node)
+            if kind != "bool":
+                raise Unwritable(f"{expr.name} is not a BOOL: it cannot be a condition", node)
+            return Compare(ref, "=", "1", True)
+        if isinstance(expr, ir.BinaryOp) and expr.op in _COMPARE:
+            return self._comparison(expr, node)
+        raise Unwritable(f"{_describe(expr)} cannot be a condition in LS", node)
+
+    def _comparison(self, expr: ir.BinaryOp, node: Any) -> Compare:
+        op = _COMPARE[expr.op]
+        left, right = expr.left, expr.right
+        if _is_input(right) or (_folded(left) is not None and _folded(right) is None):
+            left, right, op = right, left, _MIRRORED[op]
+        if isinstance(left, ir.DigitalInput):
+            state = _folded(right)
+            if not isinstance(state, bool) or op not in ("=", "<>"):
+                raise Unwritable("an input compares only with TRUE or FALSE", node)
+            on = state if op == "=" else not state
+            return Compare(f"DI[{left.index}]", "=", "ON" if on else "OFF", True)
+        state = _folded(right)
+        if isinstance(state, bool) and op in ("=", "<>") and self._type(left, node) == "bool":
+            atom = self._atom(left, node)
+            return atom if (op == "=") == state else atom.negated()
+        for side in (left, right):
+            if self._type(side, node) == "bool":
+                raise Unwritable("a comparison of BOOL values: write the BOOL itself", node)
+        lhs = self._simple(left, node)
+        rhs = self._simple(right, node)
+        standard = (
+            lhs is not None
+            and rhs is not None
+            and not lhs.startswith("PR")
+            and not lhs[:1].isdigit()
+            and _folded(left) is None
+        )
+        if standard:
+            return Compare(lhs, op, rhs, True)  # type: ignore[arg-type]
+        self._need_mixed(node, "this comparison")
+        return Compare(self._nested(left, node), op, self._nested(right, node), False)
+
+
+def _standard(cond: Condition) -> bool:
+    if isinstance(cond, Compare):
+        return cond.standard
+    return (
+        all(isinstance(p, Compare) and p.standard for p in cond.parts)
+        and len(cond.parts) <= STANDARD_CONDITIONS
+    )
+
+
+def _is_input(expr: Any) -> bool:
+    return isinstance(expr, ir.DigitalInput)
+
+
+def _folded(expr: Any) -> bool | int | float | None:
+    """A constant number (a negated constant included), else None."""
+    if isinstance(expr, ir.Constant) and isinstance(expr.value, bool | int | float):
+        if isinstance(expr.value, float) and not math.isfinite(expr.value):
+            return None
+        return expr.value
+    if isinstance(expr, ir.UnaryOp) and expr.op in ("-", "+"):
+        inner = _folded(expr.operand)
+        if isinstance(inner, int | float) and not isinstance(inner, bool):
+            return -inner if expr.op == "-" else inner
+    return None
+
+
+def _describe(expr: Any) -> str:
+    if isinstance(expr, ir.FunctionCall):
+        return f"the function call {expr.name}(...)"
+    if isinstance(expr, ir.BinaryOp):
+        return f"the operator {expr.op!r}"
+    if isinstance(expr, ir.UnaryOp):
+        return f"the operator {expr.op!r}"
+    if isinstance(expr, ir.Aggregate):
+        return "a structure value"
+    if isinstance(expr, ir.Constant):
+        return f"the constant {expr.value!r}"
+    return type(expr).__name__
+
+
+@dataclass(frozen=True, slots=True)
+class Lowered:
+    """:func:`lower`'s result: ``lines[k]``, the /MN lines of step k (empty for steps that are
+    not flow), ``problems``: (node, message) for what LS cannot express."""
+
+    lines: tuple[tuple[str, ...], ...]
+    problems: tuple[tuple[Any, str], ...]
+    unwritten: tuple[ir.Declare, ...] = ()
+    """Declarations of types LS has no register for (an error where the variable is used)."""
+
+
+def lower(events: Iterable[tuple[str, Any]], options: Mapping[str, Any]) -> Lowered:
+    """The /MN lines of every flow step of a file: ``events`` are (kind, node) pairs in the
+    order the template writes them (:func:`olp.posts.flow.weave`)."""
+    seq = list(events)
+    lowering = Lowering(options, seq)
+    lines: list[tuple[str, ...]] = []
+    problems: list[tuple[Any, str]] = []
+    for kind, node in seq:
+        if kind not in FLOW_KINDS:
+            lines.append(())
+            continue
+        try:
+            lines.append(tuple(lowering.lines(kind, node)))
+        except Unwritable as exc:
+            problems.append((exc.node, str(exc)))
+            lines.append(())
+    return Lowered(tuple(lines), tuple(problems), tuple(lowering.registers.skipped.values()))
