@@ -174,6 +174,7 @@ class Registers:
         low, high = self.ranges[bank]
         number = self.next.get(bank, low)
         if number + size - 1 > high:
+            self.skipped[key] = decl
             raise Unwritable(
                 f"{decl.name} needs {size} register(s) beyond the option {bank} [{low}, {high}]",
                 decl,
@@ -193,6 +194,8 @@ class Registers:
                 "controllers have and olp could not verify"
                 if what in ("CHAR", "STRING")
                 else "LS has no registers for that type"
+                if what not in NUMERIC_TYPES and what not in POSITION_TYPES
+                else "no register was left for it in the post option's range"
             )
             raise Unwritable(f"{name} is a {what}: {reason}", node)
         raise Unwritable(
@@ -318,6 +321,7 @@ class Lowering:
         self.next_label = len(self.labels) + 1
         self.seen_labels: set[str] = set()
         self.for_count = 0
+        self.finished_counters: set[str] = set()
 
     # -- labels ------------------------------------------------------------------------------
 
@@ -341,6 +345,20 @@ class Lowering:
                 labels.setdefault(key, len(labels) + 1)
                 around.setdefault(key, tuple(fors))
         return labels, around
+
+    def _var(self, name: str, node: Any) -> Variable:
+        """The variable ``name``; reading a FOR counter after its loop is an error: KRL leaves
+        it one step past the bound, LS's ENDFOR at the bound (manual: ENDFOR repeats while the
+        counter is below the target)."""
+        key = name.upper()
+        active = {f.node.variable.upper() for f in self.stack if f.kind == "for"}
+        if key in self.finished_counters and key not in active:
+            raise Unwritable(
+                f"{name} is used after a FOR loop that counts with it: KRL leaves it one past "
+                "the bound, LS at the bound",
+                node,
+            )
+        return self.registers.lookup(name, node)
 
     def label(self) -> int:
         self.next_label += 1
@@ -368,7 +386,7 @@ class Lowering:
     def _assign(self, node: ir.Assign) -> list[str]:
         target = node.target
         if isinstance(target, ir.Name):
-            var = self.registers.lookup(target.name, node)
+            var = self._var(target.name, node)
             if var.size != 1:
                 raise Unwritable(f"{target.name} is an array: assign its elements", node)
             if var.position:
@@ -379,7 +397,7 @@ class Lowering:
 
     def _position_value(self, var: Variable, value: Any, node: Any) -> str:
         if isinstance(value, ir.Name):
-            other = self.registers.lookup(value.name, node)
+            other = self._var(value.name, node)
             if other.position and other.kind == var.kind and other.size == 1:
                 return other.ref()
         raise Unwritable(
@@ -406,7 +424,7 @@ class Lowering:
         if isinstance(value, ir.Constant) and isinstance(value.value, bool):
             return "1" if value.value else "0"
         if isinstance(value, ir.Name):
-            var = self.registers.lookup(value.name, node)
+            var = self._var(value.name, node)
             if var.kind == "bool" and var.size == 1:
                 return var.ref()
         raise Unwritable(
@@ -493,7 +511,7 @@ class Lowering:
         frame.default = self.label() if node.default else None
         self.stack.append(frame)
         subject = node.subject
-        var = self.registers.lookup(subject.name, node) if isinstance(subject, ir.Name) else None
+        var = self._var(subject.name, node) if isinstance(subject, ir.Name) else None
         if var is None or var.kind not in ("int", "real") or var.size != 1:
             raise Unwritable("SELECT takes a numeric variable (a register) as its subject", node)
         out: list[str] = []
@@ -566,7 +584,7 @@ class Lowering:
     def _for(self, node: ir.For) -> list[str]:
         self.for_count += 1
         self.stack.append(_Frame("for", node, for_id=self.for_count))
-        var = self.registers.lookup(node.variable, node)
+        var = self._var(node.variable, node)
         if var.kind != "int" or var.size != 1:
             raise Unwritable(f"FOR counter {node.variable} must be an INT variable", node)
         step = 1 if node.step is None else _folded(node.step)
@@ -586,7 +604,7 @@ class Lowering:
                 raise Unwritable(f"FOR bound {value} is outside {FOR_RANGE}", node)
             return str(value)
         if isinstance(expr, ir.Name):
-            var = self.registers.lookup(expr.name, node)
+            var = self._var(expr.name, node)
             if var.kind == "int" and var.size == 1:
                 return var.ref()
         raise Unwritable(
@@ -597,6 +615,7 @@ class Lowering:
 
     def _end_for(self, node: ir.For) -> list[str]:
         self.stack.pop()
+        self.finished_counters.add(node.variable.upper())
         return ["  ENDFOR ;"]
 
     # -- expressions -------------------------------------------------------------------------
@@ -634,12 +653,12 @@ class Lowering:
     def _operand_ref(self, expr: Any, node: Any) -> tuple[str, str]:
         """A register reference and its value type (bool, int, real)."""
         if isinstance(expr, ir.Name):
-            var = self.registers.lookup(expr.name, node)
+            var = self._var(expr.name, node)
             if var.position or var.size != 1:
                 raise Unwritable(f"{expr.name} is not a single number", node)
             return var.ref(), var.kind
         if isinstance(expr, ir.Index) and isinstance(expr.base, ir.Name):
-            var = self.registers.lookup(expr.base.name, node)
+            var = self._var(expr.base.name, node)
             if var.position or var.size == 1 or len(expr.indices) != 1:
                 raise Unwritable(f"{expr.base.name}[...] is not an array of numbers", node)
             k = _folded(expr.indices[0])
@@ -653,7 +672,7 @@ class Lowering:
                 raise Unwritable(f"{expr.base.name}[{k}] is outside 1..{var.size}", node)
             return var.ref(k), var.kind
         if isinstance(expr, ir.Member) and isinstance(expr.base, ir.Name):
-            var = self.registers.lookup(expr.base.name, node)
+            var = self._var(expr.base.name, node)
             fields = CARTESIAN_FIELDS if var.kind == "cartesian" else JOINT_FIELDS
             j = fields.get(expr.field.upper()) if var.position and var.size == 1 else None
             if j is None:
@@ -859,4 +878,9 @@ def lower(events: Iterable[tuple[str, Any]], options: Mapping[str, Any]) -> Lowe
         except Unwritable as exc:
             problems.append((exc.node, str(exc)))
             lines.append(())
-    return Lowered(tuple(lines), tuple(problems), tuple(lowering.registers.skipped.values()))
+    unwritten = tuple(
+        decl
+        for decl in lowering.registers.skipped.values()
+        if decl.type_name.upper() not in {*NUMERIC_TYPES, *POSITION_TYPES}
+    )
+    return Lowered(tuple(lines), tuple(problems), unwritten)
