@@ -802,7 +802,7 @@ class Lowering:
             lhs is not None
             and rhs is not None
             and not lhs.startswith("PR")
-            and not lhs[:1].isdigit()
+            and not rhs.startswith("PR")
             and _folded(left) is None
         )
         if standard:

@@ -4,6 +4,7 @@ become a live line. Conventions and their sources: :mod:`olp.posts.fanuc_flow`."
 
 from __future__ import annotations
 
+import dataclasses
 import re
 import shutil
 from pathlib import Path
@@ -35,7 +36,8 @@ def post_with(tmp_path: Path, **options: object) -> str:
     for key, value in options.items():
         spelled = str(value).lower() if isinstance(value, bool) else str(value)
         text, count = re.subn(rf"(?m)^  {key}: .*$", f"  {key}: {spelled}", text)
-        assert count == 1, key
+        if not count:
+            text += f"  {key}: {spelled}\n"
     manifest.write_text(text)
     return str(folder)
 
@@ -358,3 +360,53 @@ def test_a_text_declaration_is_warned_and_its_use_is_an_error(
     assert "string registers (SR[])" in next(
         d.message for d in used.diagnostics if d.severity == "error"
     )
+
+
+def test_else_if_branches_chain_their_tests(station: object) -> None:
+    """The IR's if / else-if / else (KRL has no ELSIF; other frontends may make one)."""
+    program = _program(
+        ir.If(
+            branches=(
+                ir.Branch(
+                    condition=ir.DigitalInput(index=1), body=(ir.SetOutput(index=1, value=True),)
+                ),
+                ir.Branch(
+                    condition=ir.DigitalInput(index=2), body=(ir.SetOutput(index=2, value=True),)
+                ),
+            ),
+            orelse=(ir.SetOutput(index=3, value=True),),
+        )
+    )
+    assert mn(olp.build(station, program, post="fanuc", collisions=None)) == [
+        "  IF DI[1]=OFF,JMP LBL[1] ;",
+        "  DO[1]=ON ;",
+        "  JMP LBL[2] ;",
+        "  LBL[1] ;",
+        "  IF DI[2]=OFF,JMP LBL[3] ;",
+        "  DO[2]=ON ;",
+        "  JMP LBL[2] ;",
+        "  LBL[3] ;",
+        "  DO[3]=ON ;",
+        "  LBL[2] ;",
+    ]
+
+
+def test_a_krl_line_in_a_block_is_dropped_only_with_the_option(
+    station: object, tmp_path: Path
+) -> None:
+    body = "IF $IN[1] THEN\n$VEL.ORI1 = 150.0\n$OUT[1] = TRUE\nENDIF"
+    assert errors(build(station, tmp_path, body)) == [("verbatim", 3)]
+    dropped = build(station, tmp_path, body, foreign_verbatim="drop")
+    assert mn(dropped) == ["  IF DI[1]=OFF,JMP LBL[1] ;", "  DO[1]=ON ;", "  LBL[1] ;"]
+    assert [d.kind for d in dropped.diagnostics if d.severity == "warning"] == ["verbatim_dropped"]
+
+
+def test_the_row_writer_writes_flow_programs_as_the_template_does(station: object) -> None:
+    """Markers and labels end runs of L moves, and both ways set UFRAME_NUM/UTOOL_NUM again
+    after them."""
+    post = find_post("fanuc")
+    template = type(post)(dataclasses.replace(post.manifest, rows=False))
+    source = REPO / "tests" / "posts" / "fanuc_flow" / "cycle.src"
+    rows = olp.build(station, source, post=post, collisions=None)
+    again = olp.build(station, source, post=template, collisions=None)
+    assert rows.ok and rows.files == again.files
