@@ -64,6 +64,12 @@ endings (the files are DOS text; medium confidence that LF would also do).
   at 1 is certain, the end is unverified; a template folder may set the option ``io_range``).
 * Numbers: positions and frames are 32-bit REALs on the controller (medium confidence), held to
   0.01 mm; J speeds 1..100 %, CNT 0..100, integer mm/sec >= 1.
+* Control flow and data (``WRITES_FLOW``): blocks lowered to ``LBL[n]``/``JMP LBL[n]``,
+  ``IF ...,JMP``, ``SELECT``, ``FOR``/``ENDFOR``, ``WAIT (...)``, variables in ``R[]``/``PR[]``
+  (post options ``registers``, ``position_registers``, ``mixed_logic``), by
+  :mod:`olp.posts.fanuc_flow` (conventions and sources there); the first motion after a block
+  boundary or label sets ``UFRAME_NUM``/``UTOOL_NUM`` again. What LS cannot express is a
+  ``flow`` error on its line.
 * Long programs are split (:mod:`olp.transforms.split`, the manifest's ``limits``) into parts
   ``NAME_P1`` ... and a main program of ``CALL`` lines. The bound is RoboDK's public Fanuc post
   default of 9999 lines per program (``MAX_LINES_X_PROG``; not a documented Fanuc figure),
