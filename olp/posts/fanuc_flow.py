@@ -24,12 +24,21 @@ FOR/ENDFOR chapter of a FANUC operator manual, both as stored public pages; pinn
 * Conditions: *standard logic* (no option) writes one comparison or up to
   :data:`STANDARD_CONDITIONS` comparisons joined by only ``AND`` or only ``OR`` (course: "in
   standard logic a maximum of five logical conditions"; exports: ``IF DI[3]=ON AND DI[4]=ON,``),
-  each ``register op value`` with ``op`` one of ``= <> < <= > >=`` and the value a register or a
-  non-negative constant. Anything else needs *mixed logic* (course: AND and OR together,
-  arithmetic, ``!`` and parentheses, up to :data:`MIXED_CONDITIONS` conditions), written only when
-  the post option ``mixed_logic: true`` says the controller has it: the whole condition or value
-  in parentheses, every nested operation parenthesised so no priority rule is relied on
-  (exports: ``IF (R[10]<170 OR R[10]>400),JMP``, ``R[87]=(R[87]+1)``, ``PR[10001,3]=(-50)``).
+  each ``DI[n]=ON/OFF`` or ``R[i] op value`` with ``op`` one of ``= <> < <= > >=`` and the value
+  a register or a non-negative constant. AND with OR, or more comparisons, need *mixed logic*
+  (course: AND and OR together, arithmetic, ``!`` and parentheses, up to
+  :data:`MIXED_CONDITIONS` conditions), written only when the post option ``mixed_logic: true``
+  says the controller has it: the whole condition or value in parentheses, every nested
+  operation parenthesised so no priority rule is relied on (exports: ``IF (R[10]<170 OR
+  R[10]>400),JMP``, ``R[87]=(R[87]+1)``, ``PR[10001,3]=(-50)``).
+* Temporaries (standard logic only): arithmetic of more than one operation, a negative value, or
+  a position component or constant on a comparison's left is first computed into olp's own
+  registers ``R[n:olp_tmpK]`` (taken after the variables from the ``registers`` range), one
+  standard instruction per operation (``R[t]=a op b``, a negative value ``R[t]=0-a``; exports
+  ``R[3]=R[3]+1``, ``PR[1,1]=PR[1,1]+R[145]``; the cheat sheet's ``R[i]=PR[i,j]``). Exact: LS
+  expressions have no side effects and each operation runs once, in the expression's order; a
+  loop's test recomputes them on every pass (they sit after its label). A ``WAIT`` re-reads its
+  condition while it waits, so a WAIT on arithmetic needs mixed logic.
 * ``SELECT R[i]=v,JMP LBL[a] ;`` then one line ``=w,JMP LBL[b] ;`` per further value and
   ``ELSE,JMP LBL[c] ;`` (exports; each a numbered line). The subject must be a numeric
   variable, the values integer constants.
@@ -50,8 +59,10 @@ FOR/ENDFOR chapter of a FANUC operator manual, both as stored public pages; pinn
   KRL's A, B, C are Fanuc's R, P, W (both Rz(A)·Ry(B)·Rx(C), :mod:`olp.vendors.fanuc`), joint
   components A1..A6 are j = 1..6. Text variables (``CHAR``): string registers exist only on
   some controllers and could not be verified, so using one is an error.
-* Arithmetic: ``R[i]=a op b`` with one of ``+ - * /`` in standard logic; KRL divides two INTs
-  with truncation and rounds a REAL assigned to an INT, which LS does not: both are errors.
+* Arithmetic: ``+ - * /`` (LS's ``/`` divides as reals; ``DIV`` and ``MOD`` are separate
+  instructions); KRL divides two INTs with truncation and rounds a REAL assigned to an INT,
+  which LS does not: both are errors. A value or condition LS has no spelling for (a function
+  call, XOR, KRL's geometric ``:``, a structure value, text) is an error.
 """
 
 from __future__ import annotations
@@ -158,6 +169,7 @@ class Registers:
     variables: dict[str, Variable] = field(default_factory=dict)
     skipped: dict[str, ir.Declare] = field(default_factory=dict)
     next: dict[str, int] = field(default_factory=dict)
+    temps: list[int] = field(default_factory=list)
 
     def declare(self, decl: ir.Declare) -> Variable | None:
         """Allocate ``decl``; None for a type LS has no register for (noted in ``skipped``)."""
@@ -182,6 +194,22 @@ class Registers:
         self.next[bank] = number + size
         self.variables[key] = var = Variable(decl.name, kind, number, size)
         return var
+
+    def temporary(self, k: int, node: Any) -> str:
+        """``R[n:olp_tmpK]``, the k-th (0-based) temporary register, allocated on first use
+        after the variables declared so far (declarations come first in a file)."""
+        while len(self.temps) <= k:
+            low, high = self.ranges["registers"]
+            number = self.next.get("registers", low)
+            if number > high:
+                raise Unwritable(
+                    f"no register left in the option registers [{low}, {high}] for a "
+                    "temporary value",
+                    node,
+                )
+            self.next["registers"] = number + 1
+            self.temps.append(number)
+        return f"R[{self.temps[k]}:olp_tmp{k + 1}]"
 
     def lookup(self, name: str, node: Any) -> Variable:
         var = self.variables.get(name.upper())
@@ -322,6 +350,7 @@ class Lowering:
         self.seen_labels: set[str] = set()
         self.for_count = 0
         self.finished_counters: set[str] = set()
+        self.pre: list[str] = []
 
     # -- labels ------------------------------------------------------------------------------
 
@@ -367,8 +396,14 @@ class Lowering:
     # -- statements --------------------------------------------------------------------------
 
     def lines(self, kind: str, node: Any) -> list[str]:
+        self.pre = []
         handler = getattr(self, "_" + kind)
         out: list[str] = handler(node)
+        return out
+
+    def _drain(self) -> list[str]:
+        """The temporary lines the statement being written needs first."""
+        out, self.pre = self.pre, []
         return out
 
     def _declare(self, decl: ir.Declare) -> list[str]:
@@ -418,7 +453,8 @@ class Lowering:
                 "fraction",
                 node,
             )
-        return [f"  {ref}={self._value(value, node)} ;"]
+        text = self._value(value, node)
+        return [*self._drain(), f"  {ref}={text} ;"]
 
     def _bool_value(self, value: Any, node: Any) -> str:
         if isinstance(value, ir.Constant) and isinstance(value.value, bool):
@@ -434,7 +470,11 @@ class Lowering:
         )
 
     def _wait_until(self, node: ir.WaitUntil) -> list[str]:
-        return [f"  WAIT {self._condition(node.condition, node)} ;"]
+        text = self._condition(node.condition, node)
+        if self.pre:
+            what = "a WAIT on arithmetic (it re-reads its condition: no temporary can hold it)"
+            self._need_mixed(node, what)
+        return [f"  WAIT {text} ;"]
 
     def _label(self, node: ir.Label) -> list[str]:
         key = node.name.upper()
@@ -475,14 +515,14 @@ class Lowering:
 
     # -- blocks ------------------------------------------------------------------------------
 
-    def _jump_unless(self, condition: Any, target: int, node: Any) -> str:
+    def _jump_unless(self, condition: Any, target: int, node: Any) -> list[str]:
         text = self._condition(condition, node, negate=True)
-        return f"  IF {text},JMP LBL[{target}] ;"
+        return [*self._drain(), f"  IF {text},JMP LBL[{target}] ;"]
 
     def _if(self, node: ir.If) -> list[str]:
         frame = _Frame("if", node, end=None, next=self.label())
         self.stack.append(frame)
-        return [self._jump_unless(node.branches[0].condition, frame.next, node)]  # type: ignore[arg-type]
+        return self._jump_unless(node.branches[0].condition, frame.next, node)  # type: ignore[arg-type]
 
     def _elif(self, branch: ir.Branch) -> list[str]:
         frame = self.stack[-1]
@@ -490,7 +530,7 @@ class Lowering:
             frame.end = self.label()
         out = [f"  JMP LBL[{frame.end}] ;", f"  LBL[{frame.next}] ;"]
         frame.next = self.label()
-        return [*out, self._jump_unless(branch.condition, frame.next, branch)]
+        return [*out, *self._jump_unless(branch.condition, frame.next, branch)]
 
     def _else(self, node: ir.If) -> list[str]:
         frame = self.stack[-1]
@@ -559,7 +599,7 @@ class Lowering:
     def _while(self, node: ir.While) -> list[str]:
         frame = self._loop_head("while", node)
         frame.end = self.label()
-        return [f"  LBL[{frame.top}] ;", self._jump_unless(node.condition, frame.end, node)]
+        return [f"  LBL[{frame.top}] ;", *self._jump_unless(node.condition, frame.end, node)]
 
     def _end_while(self, node: ir.While) -> list[str]:
         frame = self.stack.pop()
@@ -570,7 +610,7 @@ class Lowering:
 
     def _until(self, node: ir.Repeat) -> list[str]:
         frame = self.stack.pop()
-        out = [self._jump_unless(node.until, frame.top, node)]  # type: ignore[arg-type]
+        out = self._jump_unless(node.until, frame.top, node)  # type: ignore[arg-type]
         return out + ([] if frame.end is None else [f"  LBL[{frame.end}] ;"])
 
     def _loop(self, node: ir.Loop) -> list[str]:
@@ -683,12 +723,49 @@ class Lowering:
         raise Unwritable(f"{_describe(expr)} cannot be written in LS", node)
 
     def _value(self, expr: Any, node: Any) -> str:
-        """A numeric value: standard ``a``, ``a op b``; else ``(...)`` with mixed logic."""
+        """A numeric value: standard ``a``, ``a op b``; else ``(...)`` with mixed logic, or
+        without it the inner operations computed into temporaries first (:meth:`_operand`)."""
+        self._type(expr, node)
         standard = self._standard_value(expr, node)
         if standard is not None:
             return standard
-        self._need_mixed(node, "this arithmetic")
-        return f"({self._mixed_value(expr, node)})"
+        if self.mixed:
+            return f"({self._mixed_value(expr, node)})"
+        if isinstance(expr, ir.BinaryOp) and expr.op in _ARITHMETIC:
+            left = self._operand(expr.left, node)
+            return f"{left}{expr.op}{self._operand(expr.right, node)}"
+        value = _folded(expr)
+        if isinstance(value, int | float) and not isinstance(value, bool):
+            return f"0-{self._constant(-value, node)}"
+        if isinstance(expr, ir.UnaryOp) and expr.op == "-":
+            return f"0-{self._operand(expr.operand, node)}"
+        return self._operand(expr, node)
+
+    def _operand(self, expr: Any, node: Any) -> str:
+        """A standard-logic operand for ``expr``: itself when it is a register or a
+        non-negative constant, else a temporary register holding it, computed by one standard
+        instruction per operation (``R[t]=a op b``; a negative value as ``R[t]=0-a``). Exact:
+        LS expressions have no side effects, each operation is evaluated once in the order
+        the expression gives, and the temporaries are olp's own registers."""
+        simple = self._simple(expr, node)
+        if simple is not None:
+            return simple
+        value = _folded(expr)
+        if isinstance(value, int | float) and not isinstance(value, bool):
+            text = f"0-{self._constant(-value, node)}"
+        elif isinstance(expr, ir.UnaryOp) and expr.op == "-":
+            text = f"0-{self._operand(expr.operand, node)}"
+        elif isinstance(expr, ir.UnaryOp) and expr.op == "+":
+            return self._operand(expr.operand, node)
+        elif isinstance(expr, ir.BinaryOp) and expr.op in _ARITHMETIC:
+            self._type(expr, node)
+            left = self._operand(expr.left, node)
+            text = f"{left}{expr.op}{self._operand(expr.right, node)}"
+        else:
+            raise Unwritable(f"{_describe(expr)} cannot be written in LS", node)
+        temp = self.registers.temporary(len(self.pre), node)
+        self.pre.append(f"  {temp}={text} ;")
+        return temp
 
     def _standard_value(self, expr: Any, node: Any) -> str | None:
         simple = self._simple(expr, node)
@@ -737,9 +814,8 @@ class Lowering:
     def _need_mixed(self, node: Any, what: str) -> None:
         if not self.mixed:
             raise Unwritable(
-                f"{what} needs LS mixed logic (AND with OR, arithmetic in a condition, "
-                "parentheses, negative constants, more than one operator); set the post option "
-                "mixed_logic: true if the controller has it",
+                f"{what} needs LS mixed logic; set the post option mixed_logic: true if the "
+                "controller has it",
                 node,
             )
 
@@ -747,7 +823,13 @@ class Lowering:
         cond = _flat(self._cond(expr, node, negate))
         if _standard(cond):
             return _mixed_text(cond)
-        self._need_mixed(node, "this condition")
+        count = _count(cond)
+        self._need_mixed(
+            node,
+            f"a condition of {count} comparisons (standard logic takes {STANDARD_CONDITIONS})"
+            if count > STANDARD_CONDITIONS and not _mixes(cond)
+            else "AND together with OR in one condition",
+        )
         if _count(cond) > MIXED_CONDITIONS:
             raise Unwritable(
                 f"the condition has {_count(cond)} comparisons; LS mixed logic takes at most "
@@ -807,8 +889,18 @@ class Lowering:
         )
         if standard:
             return Compare(lhs, op, rhs, True)  # type: ignore[arg-type]
-        self._need_mixed(node, "this comparison")
-        return Compare(self._nested(left, node), op, self._nested(right, node), False)
+        if self.mixed:
+            return Compare(self._nested(left, node), op, self._nested(right, node), False)
+        if lhs is None or not lhs.startswith("R["):
+            lhs = self.registers.temporary(len(self.pre), node)
+            self.pre.append(f"  {lhs}={self._value(left, node)} ;")
+        if rhs is None or rhs.startswith("PR"):
+            rhs = self._operand(right, node)
+        return Compare(lhs, op, rhs, True)
+
+
+def _mixes(cond: Condition) -> bool:
+    return isinstance(cond, Logic) and any(isinstance(p, Logic) for p in cond.parts)
 
 
 def _standard(cond: Condition) -> bool:
