@@ -336,6 +336,7 @@ class _Frame:
     cases: list[int] = field(default_factory=list)
     default: int | None = None
     for_id: int = 0
+    seen: int = 0
 
 
 class Lowering:
@@ -410,10 +411,10 @@ class Lowering:
         var = self.registers.declare(decl)
         if var is None or decl.value is None:
             return []
-        if var.position:
+        if var.position or var.size != 1:
             raise Unwritable(
-                f"the initial value of {decl.name}: LS cannot write a position value into a "
-                "position register in one line",
+                f"the initial value of {decl.name}: LS sets a position register or an array "
+                "element by element, and olp does not verify doing so for a whole value",
                 decl,
             )
         return self._store(var.ref(), var.kind, decl.value, decl)
@@ -421,12 +422,14 @@ class Lowering:
     def _assign(self, node: ir.Assign) -> list[str]:
         target = node.target
         if isinstance(target, ir.Name):
-            var = self._var(target.name, node)
+            var = self.registers.lookup(target.name, node)  # a write: both languages agree
             if var.size != 1:
                 raise Unwritable(f"{target.name} is an array: assign its elements", node)
             if var.position:
                 return [f"  {var.ref()}={self._position_value(var, node.value, node)} ;"]
-            return self._store(var.ref(), var.kind, node.value, node)
+            out = self._store(var.ref(), var.kind, node.value, node)
+            self.finished_counters.discard(target.name.upper())
+            return out
         ref, kind = self._operand_ref(target, node)
         return self._store(ref, kind, node.value, node)
 
@@ -578,7 +581,8 @@ class Lowering:
 
     def _case(self, case: ir.Case) -> list[str]:
         frame = self.stack[-1]
-        k = next(i for i, c in enumerate(frame.node.cases) if c is case)
+        k = frame.seen
+        frame.seen += 1
         lead = [f"  JMP LBL[{self._end(frame)}] ;"] if k > 0 else []
         return [*lead, f"  LBL[{frame.cases[k]}] ;"]
 
@@ -670,6 +674,8 @@ class Lowering:
                 return "int"
             if isinstance(v, float):
                 return "real"
+            if expr.enum:
+                raise Unwritable(f"the enumeration value #{v} has no LS equivalent", node)
             raise Unwritable(f"the text {v!r}: LS registers hold numbers", node)
         if isinstance(expr, ir.Name | ir.Index | ir.Member):
             return self._operand_ref(expr, node)[1]

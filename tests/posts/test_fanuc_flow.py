@@ -254,9 +254,10 @@ REFUSES = {
         [("flow", 5)],
     ),
     "counter_after_for": (
-        "DECL INT i, n\nFOR i = 1 TO 3\n$OUT[1] = TRUE\nENDFOR\nn = i",
-        [("flow", 6)],
+        "DECL INT i, n\nFOR i = 1 TO 3\n$OUT[1] = TRUE\nENDFOR\nn = i\ni = 7\nn = i",
+        [("flow", 6)],  # read after the loop; after i = 7 both languages agree again
     ),
+    "enumeration_value": ("DECL INT n\nn = #BASE", [("flow", 3)]),
     "and_with_or_needs_mixed_logic": (
         "IF ($IN[1] OR $IN[2]) AND $IN[3] THEN\n$OUT[1] = TRUE\nENDIF",
         [("flow", 2)],
