@@ -16,6 +16,7 @@ from olp import ir
 from olp.posts import find_post
 from olp.vendors.fanuc import pose_to_xyzwpr
 from olp.vendors.kuka import frame_to_pose
+from tests.posts import ls_machine
 
 REPO = Path(__file__).resolve().parents[2]
 CELL = REPO / "stations" / "fanuc_m20ia_weld_cell.yaml"
@@ -443,3 +444,72 @@ def test_the_row_writer_writes_flow_programs_as_the_template_does(station: objec
     rows = olp.build(station, source, post=post, collisions=None)
     again = olp.build(station, source, post=template, collisions=None)
     assert rows.ok and rows.files == again.files
+
+
+COUNTERS = """
+DECL INT n, i, k, nMode
+n = 0
+k = 0
+WHILE n < 5
+  n = n + 2
+  $OUT[1] = TRUE
+ENDWHILE
+FOR i = 1 TO 3
+  k = k + i * 2
+ENDFOR
+REPEAT
+  k = k - 4
+UNTIL (k < 0) OR $IN[1]
+nMode = k + 5
+SWITCH nMode
+CASE 1
+  $OUT[2] = TRUE
+CASE 3, 4
+  $OUT[3] = TRUE
+DEFAULT
+  $OUT[4] = TRUE
+ENDSWITCH
+LOOP
+  k = k + 1
+  IF (k > 3) AND NOT $IN[2] THEN
+    EXIT
+  ENDIF
+  IF $IN[2] AND (k > 6) THEN
+    EXIT
+  ENDIF
+ENDLOOP
+IF NOT ($IN[3] OR $IN[4]) THEN
+  $OUT[5] = TRUE
+ELSE
+  $OUT[6] = TRUE
+ENDIF
+"""
+RUNS = [
+    # inputs ON, then what the KRL program does (worked by hand): outputs set, n, k, nMode
+    ((), ["DO[1]=ON"] * 3 + ["DO[2]=ON", "DO[5]=ON"], 6, 4, 1),
+    ((1,), ["DO[1]=ON"] * 3 + ["DO[4]=ON", "DO[5]=ON"], 6, 9, 13),
+    ((2, 3), ["DO[1]=ON"] * 3 + ["DO[2]=ON", "DO[6]=ON"], 6, 7, 1),
+]
+
+
+@pytest.mark.parametrize("mixed", [False, True], ids=["standard", "mixed"])
+@pytest.mark.parametrize("run_", RUNS, ids=lambda r: f"inputs{list(r[0])}")
+def test_the_ls_program_does_what_the_krl_program_does(
+    station: object, tmp_path: Path, mixed: bool, run_: tuple
+) -> None:
+    """The lowering run on a small LS interpreter (tests/posts/ls_machine.py): outputs in
+    order and the variables at the end, as worked out from the KRL source."""
+    inputs, outputs, n, k, mode = run_
+    options = {"mixed_logic": True} if mixed else {}
+    result = build(station, tmp_path, COUNTERS, **options)
+    (text,) = result.files.values()
+    done = ls_machine.run(text, {index: True for index in inputs})
+    assert done.trace == outputs
+    assert (done.r[101], done.r[103], done.r[104]) == (n, k, mode)
+
+
+def test_every_jump_of_the_flow_goldens_lands_on_one_label() -> None:
+    goldens = sorted((REPO / "tests" / "golden" / "fanuc").glob("flow_*/*.ls"))
+    assert len(goldens) == 2
+    for path in goldens:
+        ls_machine.run(path.read_text(), {1: True, 2: True, 3: True, 4: False})
