@@ -74,6 +74,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from olp import ir
+from olp.errors import PostError
 from olp.posts.numbers import NumberError, NumberFormat, format_number
 
 STANDARD_CONDITIONS = 5
@@ -253,15 +254,31 @@ def _int_constant(expr: Any) -> bool:
 
 
 def register_ranges(options: Mapping[str, Any]) -> dict[str, tuple[int, int]]:
-    """The option ranges ``registers`` and ``position_registers`` as (first, last)."""
+    """The option ranges ``registers`` and ``position_registers`` as (first, last); a value
+    that is not two register numbers, first <= last, is a PostError naming the option."""
     out = {}
     for key, default in (
         ("registers", DEFAULT_REGISTERS),
         ("position_registers", DEFAULT_POSITION_REGISTERS),
     ):
-        low, high = (int(v) for v in options.get(key, default))
-        out[key] = (low, high)
+        given = options.get(key, default)
+        numbers = list(given) if isinstance(given, list | tuple) else []
+        if len(numbers) != 2 or not all(type(v) is int for v in numbers):
+            raise PostError(
+                f"post option {key}: expected [first, last] register numbers, got {given!r}"
+            )
+        if not 1 <= numbers[0] <= numbers[1]:
+            raise PostError(f"post option {key}: {given!r} is not a range of register numbers")
+        out[key] = (numbers[0], numbers[1])
     return out
+
+
+def mixed_logic(options: Mapping[str, Any]) -> bool:
+    """The option ``mixed_logic`` (true or false; anything else is a PostError)."""
+    value = options.get("mixed_logic", False)
+    if not isinstance(value, bool):
+        raise PostError(f"post option mixed_logic: expected true or false, got {value!r}")
+    return value
 
 
 # --------------------------------------------------------------------------------------------
@@ -343,7 +360,7 @@ class Lowering:
     """The ``/MN`` lines of a file's steps (:func:`lower`)."""
 
     def __init__(self, options: Mapping[str, Any], events: Sequence[tuple[str, Any]]) -> None:
-        self.mixed = bool(options.get("mixed_logic", False))
+        self.mixed = mixed_logic(options)
         self.registers = Registers(register_ranges(options))
         self.stack: list[_Frame] = []
         self.labels, self.label_fors = self._program_labels(events)

@@ -13,6 +13,7 @@ import pytest
 
 import olp
 from olp import ir
+from olp.errors import PostError
 from olp.posts import find_post
 from olp.vendors.fanuc import pose_to_xyzwpr
 from olp.vendors.kuka import frame_to_pose
@@ -508,8 +509,29 @@ def test_the_ls_program_does_what_the_krl_program_does(
     assert (done.r[101], done.r[103], done.r[104]) == (n, k, mode)
 
 
-def test_every_jump_of_the_flow_goldens_lands_on_one_label() -> None:
+def test_the_flow_goldens_are_numbered_and_every_jump_lands_on_one_label() -> None:
     goldens = sorted((REPO / "tests" / "golden" / "fanuc").glob("flow_*/*.ls"))
     assert len(goldens) == 2
     for path in goldens:
-        ls_machine.run(path.read_text(), {1: True, 2: True, 3: True, 4: False})
+        text = path.read_text()
+        ls_machine.run(text, {1: True, 2: True, 3: True, 4: False})
+        mn = text.split("/MN\n")[1].split("\n/POS")[0].split("\n")
+        numbers = [int(line.split(":")[0]) for line in mn]
+        assert numbers == list(range(1, len(mn) + 1))
+        assert f"LINE_COUNT\t= {len(mn)};" in text
+
+
+@pytest.mark.parametrize(
+    ("option", "value"),
+    [
+        ("registers", "abc"),
+        ("registers", "[9, 3]"),
+        ("position_registers", "[0, 5]"),
+        ("mixed_logic", "'yes'"),
+    ],
+)
+def test_a_bad_register_option_is_a_post_error(
+    station: object, tmp_path: Path, option: str, value: str
+) -> None:
+    with pytest.raises(PostError, match=f"post option {option}"):
+        build(station, tmp_path, "DECL INT n\nn = 1", **{option: value})
