@@ -63,6 +63,14 @@ FOR/ENDFOR chapter of a FANUC operator manual, both as stored public pages; pinn
   instructions); KRL divides two INTs with truncation and rounds a REAL assigned to an INT,
   which LS does not: both are errors. A value or condition LS has no spelling for (a function
   call, XOR, KRL's geometric ``:``, a structure value, text) is an error.
+
+Not verified here (no controller, no MakeTP): whether converting an LS file sets a register's
+comment from ``R[n:name]`` or ignores it (exports write it on every reference; olp writes the
+same form); the longest line the converter takes (exports wrap long mixed-logic lines with
+``:`` continuation lines, olp writes each statement on one line); the comment and label number
+limits; whether mixed logic is standard on a given controller (hence the option). Variables a
+KRL program declares only in a ``.dat`` or ``$config.dat`` are not in the IR, so their use is an
+"undeclared" error rather than a guess of their type and register.
 """
 
 from __future__ import annotations
