@@ -25,12 +25,14 @@ FOR/ENDFOR chapter of a FANUC operator manual, both as stored public pages; pinn
   :data:`STANDARD_CONDITIONS` comparisons joined by only ``AND`` or only ``OR`` (course: "in
   standard logic a maximum of five logical conditions"; exports: ``IF DI[3]=ON AND DI[4]=ON,``),
   each ``DI[n]=ON/OFF`` or ``R[i] op value`` with ``op`` one of ``= <> < <= > >=`` and the value
-  a register or a non-negative constant. AND with OR, or more comparisons, need *mixed logic*
-  (course: AND and OR together, arithmetic, ``!`` and parentheses, up to
-  :data:`MIXED_CONDITIONS` conditions), written only when the post option ``mixed_logic: true``
-  says the controller has it: the whole condition or value in parentheses, every nested
-  operation parenthesised so no priority rule is relied on (exports: ``IF (R[10]<170 OR
-  R[10]>400),JMP``, ``R[87]=(R[87]+1)``, ``PR[10001,3]=(-50)``).
+  a register or a non-negative constant. A jump on AND with OR, or on more comparisons, becomes
+  a chain of such ``IF`` lines with short cuts (:meth:`Lowering._jumps`; exact, as LS
+  conditions have no side effects). *Mixed logic* (course: AND and OR together, arithmetic,
+  ``!`` and parentheses, up to :data:`MIXED_CONDITIONS` conditions) is written only when the
+  post option ``mixed_logic: true`` says the controller has it: the whole condition or value in
+  one line, in parentheses, every nested operation parenthesised so no priority rule is relied
+  on (exports: ``IF (R[10]<170 OR R[10]>400),JMP``, ``R[87]=(R[87]+1)``,
+  ``PR[10001,3]=(-50)``). A ``WAIT`` is one line: AND with OR there needs mixed logic.
 * Temporaries (standard logic only): arithmetic of more than one operation, a negative value, or
   a position component or constant on a comparison's left is first computed into olp's own
   registers ``R[n:olp_tmpK]`` (taken after the variables from the ``registers`` range), one
@@ -544,8 +546,31 @@ class Lowering:
     # -- blocks ------------------------------------------------------------------------------
 
     def _jump_unless(self, condition: Any, target: int, node: Any) -> list[str]:
-        text = self._condition(condition, node, negate=True)
-        return [*self._drain(), f"  IF {text},JMP LBL[{target}] ;"]
+        """Lines that jump to ``target`` when ``condition`` does not hold: one ``IF``, or in
+        standard logic, for a condition standard logic cannot write in one line, a chain of
+        them (:meth:`_jumps`)."""
+        cond = _flat(self._cond(condition, node, negate=True))
+        if self.mixed or _standard(cond):
+            text = self._condition_text(cond, node)
+            return [*self._drain(), f"  IF {text},JMP LBL[{target}] ;"]
+        lines = self._jumps(cond, target)
+        return [*self._drain(), *lines]
+
+    def _jumps(self, cond: Condition, target: int) -> list[str]:
+        """Standard-logic ``IF`` lines jumping to ``target`` exactly when ``cond`` holds,
+        evaluated left to right with short cuts (exact: LS conditions have no side effects).
+        OR: each group of up to :data:`STANDARD_CONDITIONS` comparisons, or nested AND, jumps
+        to ``target`` itself. AND: every group but the last jumps over the rest when it does
+        not hold, the last jumps to ``target``."""
+        if _standard(cond):
+            return [f"  IF {_mixed_text(cond)},JMP LBL[{target}] ;"]
+        assert isinstance(cond, Logic)
+        groups = _groups(cond)
+        if cond.op == "OR":
+            return [line for group in groups for line in self._jumps(group, target)]
+        skip = self.label()
+        out = [line for group in groups[:-1] for line in self._jumps(_flat(group.negated()), skip)]
+        return [*out, *self._jumps(groups[-1], target), f"  LBL[{skip}] ;"]
 
     def _if(self, node: ir.If) -> list[str]:
         frame = _Frame("if", node, end=None, next=self.label())
@@ -851,7 +876,10 @@ class Lowering:
             )
 
     def _condition(self, expr: Any, node: Any, negate: bool = False) -> str:
-        cond = _flat(self._cond(expr, node, negate))
+        return self._condition_text(_flat(self._cond(expr, node, negate)), node)
+
+    def _condition_text(self, cond: Condition, node: Any) -> str:
+        """One line's condition: standard, or mixed logic in parentheses."""
         if _standard(cond):
             return _mixed_text(cond)
         count = _count(cond)
@@ -928,6 +956,23 @@ class Lowering:
         if rhs is None or rhs.startswith("PR"):
             rhs = self._operand(right, node)
         return Compare(lhs, op, rhs, True)
+
+
+def _groups(cond: Logic) -> list[Condition]:
+    """The parts of a chain with runs of comparisons cut into standard chains (at most
+    :data:`STANDARD_CONDITIONS` each), nested chains kept whole."""
+    out: list[Condition] = []
+    run: list[Compare] = []
+    for part in [*cond.parts, None]:
+        if isinstance(part, Compare) and len(run) < STANDARD_CONDITIONS:
+            run.append(part)
+            continue
+        if run:
+            out.append(run[0] if len(run) == 1 else Logic(cond.op, tuple(run)))
+        run = [part] if isinstance(part, Compare) else []
+        if isinstance(part, Logic):
+            out.append(part)
+    return out
 
 
 def _mixes(cond: Condition) -> bool:
