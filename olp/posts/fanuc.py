@@ -305,7 +305,7 @@ def ls_flow(
     other step. They are built from checked pieces (register and label numbers, comments of
     letters, digits and ``_``, checked numbers). What LS cannot express becomes an error on its
     line (:meth:`FanucPost.check_program` reports the same before rendering)."""
-    lowered = lower(((s.kind, s.instruction) for s in steps), options)
+    lowered = lower(((s.kind, s.instruction) for s in steps), options, post.io_range)
     for node, message in lowered.problems:
         text = f"{_what(node)} cannot be written in LS: {message}"
         post.problems.append(Diagnostic("error", "flow", text, getattr(node, "span", None)))
@@ -572,7 +572,7 @@ def _flow_checks(post: Post, compiled: CompiledProgram) -> list[Diagnostic]:
 
     steps = [PostStep(s.index, s.instruction.kind, "", s.instruction) for s in compiled.steps]
     events = [(s.kind, s.instruction) for s in weave(compiled.program, steps)]
-    lowered = lower(events, post.options)
+    lowered = lower(events, post.options, post.io_range)
     out = [
         Diagnostic("error", "flow", f"{_what(node)} cannot be written in LS: {msg}", node.span)
         for node, msg in lowered.problems

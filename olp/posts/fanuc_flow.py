@@ -379,6 +379,7 @@ class Lowering:
         self.for_count = 0
         self.finished_counters: set[str] = set()
         self.pre: list[str] = []
+        self.io_range: tuple[int, int] | None = None
 
     # -- labels ------------------------------------------------------------------------------
 
@@ -907,9 +908,19 @@ class Lowering:
         atom = self._atom(expr, node)
         return atom.negated() if negate else atom
 
+    def _input(self, expr: ir.DigitalInput, on: bool, node: Any) -> Compare:
+        """``DI[n]=ON`` / ``OFF``, n within the post's I/O range."""
+        low, high = self.io_range or (expr.index, expr.index)
+        if not low <= expr.index <= high:
+            raise Unwritable(
+                f"digital input {expr.index} is outside the LS controller's range {low}..{high}",
+                node,
+            )
+        return Compare(f"DI[{expr.index}]", "=", "ON" if on else "OFF", True)
+
     def _atom(self, expr: Any, node: Any) -> Compare:
         if isinstance(expr, ir.DigitalInput):
-            return Compare(f"DI[{expr.index}]", "=", "ON", True)
+            return self._input(expr, True, node)
         if isinstance(expr, ir.Name):
             ref, kind = self._operand_ref(expr, node)
             if kind != "bool":
@@ -928,8 +939,7 @@ class Lowering:
             state = _folded(right)
             if not isinstance(state, bool) or op not in ("=", "<>"):
                 raise Unwritable("an input compares only with TRUE or FALSE", node)
-            on = state if op == "=" else not state
-            return Compare(f"DI[{left.index}]", "=", "ON" if on else "OFF", True)
+            return self._input(left, state if op == "=" else not state, node)
         state = _folded(right)
         if isinstance(state, bool) and op in ("=", "<>") and self._type(left, node) == "bool":
             atom = self._atom(left, node)
@@ -1030,11 +1040,17 @@ class Lowered:
     """Declarations of types LS has no register for (an error where the variable is used)."""
 
 
-def lower(events: Iterable[tuple[str, Any]], options: Mapping[str, Any]) -> Lowered:
+def lower(
+    events: Iterable[tuple[str, Any]],
+    options: Mapping[str, Any],
+    io_range: tuple[int, int] | None = None,
+) -> Lowered:
     """The /MN lines of every flow step of a file: ``events`` are (kind, node) pairs in the
-    order the template writes them (:func:`olp.posts.flow.weave`)."""
+    order the template writes them (:func:`olp.posts.flow.weave`); ``io_range``: the input
+    numbers the controller has (:attr:`olp.posts.base.Post.io_range`)."""
     seq = list(events)
     lowering = Lowering(options, seq)
+    lowering.io_range = io_range
     lines: list[tuple[str, ...]] = []
     problems: list[tuple[Any, str]] = []
     for kind, node in seq:

@@ -300,6 +300,7 @@ REFUSES = {
     "function_call": ("DECL INT n\nn = Answer(3)", [("flow", 3)]),
     "position_literal": ("DECL FRAME f\nf = {X 1.0, Y 2.0}", [("flow", 3)]),
     "foreign_verbatim": ("$VEL.ORI1 = 150.0", [("verbatim", 2)]),
+    "input_out_of_range": ("IF $IN[5000] THEN\n$OUT[1] = TRUE\nENDIF", [("flow", 2)]),
 }
 
 
