@@ -192,7 +192,10 @@ def estimate_scope(compiled: CompiledProgram) -> tuple[str, str]:
             m.speed.linear_acceleration is not None or m.speed.angular_acceleration is not None
             for m in path
         )
+        default = compiled.station.robot.limits.path_acceleration
         extra = ", path accelerations" if accels else ""
+        if default is not None:
+            extra += f", the controller's path acceleration of {default:g} m/s²"
         parts.append(
             "linear and circular moves at the shortest time within the axis limits (jerk "
             f"included) and the programmed TCP speed{extra}, zones rounded as blends"
@@ -203,6 +206,12 @@ def estimate_scope(compiled: CompiledProgram) -> tuple[str, str]:
         "settling at exact stops, payload and motor-torque limits, and the time of I/O and "
         "called routines beyond the fixed times"
     )
+    unset = [m for m in path if m.speed.linear_acceleration is None]
+    if unset and not on_ur and compiled.station.robot.limits.path_acceleration is None:
+        excludes += (
+            "; the controller's own path acceleration where the program sets none (unknown "
+            "to the station: olp time --calibrate fits it from a recording)"
+        )
     stops = sum(1 for d in compiled.diagnostics if d.kind == "zone_stop")
     if stops:
         excludes += (
