@@ -29,9 +29,9 @@ What every post checks (:meth:`Post.check`), so that no brand can forget it:
 * digital I/O numbers within the controller's range (``IO_RANGE``, ``io_range``);
 * a station robot of another brand than the post's (a warning, ``foreign_robot``);
 * a :class:`~olp.ir.Verbatim` statement of another language than the post's ``VERBATIM`` is an
-  error naming its line (``verbatim``); with the template folder's option
-  ``foreign_verbatim: drop`` it is left out with a warning showing its text
-  (``verbatim_dropped``).
+  error naming its line (``verbatim``); with the post option ``foreign_verbatim: drop`` (in a
+  template folder, or ``olp build --drop-foreign-verbatim``) it is left out with a warning
+  showing its text (``verbatim_dropped``).
 
 Numbers are written through :meth:`Post.number` with a quantity of ``NUMBERS``
 (:mod:`olp.posts.numbers`): a value the controller cannot hold as checked and timed is an error on
@@ -206,6 +206,11 @@ class Post:
     def check_program(self, compiled: CompiledProgram) -> list[Diagnostic]:
         """What this language cannot say exactly about the whole program."""
         return []
+
+    def reserved_names(self, compiled: CompiledProgram) -> Sequence[str]:
+        """Names the program's own statements use (variables, labels), which the names olp
+        makes up for points, tools and frames must not take; none by default."""
+        return ()
 
     # ----------------------------------------------------------------------------------------
     # The pipeline
@@ -447,7 +452,10 @@ class Post:
             return self._encoding_checks(step, "verbatim", ins.text)
         what = f"{ins.language.upper()} statement {_quote(ins.text)} (line {ins.span.line})"
         if self.options.get("foreign_verbatim") == "drop":
-            msg = f"{what} is not written: the option foreign_verbatim: drop leaves it out"
+            msg = (
+                f"{what} is not written: foreign_verbatim: drop (olp build "
+                "--drop-foreign-verbatim) leaves it out"
+            )
             return [Diagnostic("warning", "verbatim_dropped", msg, ins.span, step.index)]
         msg = (
             f"{what} is kept verbatim because olp does not model it ({ins.reason}); the "
@@ -455,7 +463,8 @@ class Post:
         )
         hint = (
             "write it for this controller by hand, remove it from the source program, or leave "
-            "it out with a warning: the post option foreign_verbatim: drop (in a copy of the post)"
+            "it out with a warning: olp build --drop-foreign-verbatim (the post option "
+            "foreign_verbatim: drop)"
         )
         return [_error("verbatim", msg, step, hint=hint)]
 

@@ -52,14 +52,19 @@ Conventions shared with frontends (rotation vectors, the flange, no configuratio
 * Numbers: URScript's float width is unverified (believed 64-bit); positions are written to
   1 µm and checked to 10 µm, speeds and accelerations must stay positive once printed, and a
   ``sleep`` above :data:`MAX_SLEEP` s is refused (olp's bound; URScript states none).
+* Control flow and data (:mod:`olp.ir_flow`): :mod:`olp.posts.ur_flow`, with its sources. A
+  template folder writes them only if its options say ``writes_flow: true`` (the bundled one
+  does): a folder copied before would write every block's body unconditionally, so a program
+  with control flow stops on such a folder with an error (``control_flow``).
 * Comments: ``#`` to the end of the line, whitespace collapsed; a comment of several lines
   becomes several ``#`` lines.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import re
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
@@ -68,9 +73,11 @@ from numpy.typing import ArrayLike
 from olp.diagnostics import Diagnostic
 from olp.ir import ArcOrientation
 from olp.posts.base import Filter, Post
+from olp.posts.flow_text import FLOW_STEP_KINDS, Symbols, flow_problems
 from olp.posts.numbers import NumberFormat
 from olp.posts.sandbox import SafeText
 from olp.posts.text import NUMBER, ArgumentRule, CommentRule, NameRule
+from olp.posts.ur_flow import UrWriter
 from olp.vendors.ur import (
     MOTION_DECIMALS,
     movej_parameters,
@@ -226,8 +233,24 @@ def _blends_filter(post: Post, steps: Any, station: Any) -> dict[int, float]:
     return {c.index: c.radius for c in blend_radii(list(steps), robot, robot.home)}
 
 
+def _flow_filter(post: Post, step: PostStep) -> SafeText:
+    """Template filter: ``s | ur_flow``, the lines of a marker or flow statement
+    (:class:`olp.posts.ur_flow.UrWriter`), indented ('' for a marker that writes nothing)."""
+    assert isinstance(post, UrPost) and post.flow is not None
+    return post.flow.lines(step)
+
+
+def _pad_filter(post: Post, step: Any) -> int:
+    """Template filter: ``s | ur_pad``, the extra indentation of an ordinary statement inside
+    blocks (0 outside any)."""
+    flow = getattr(post, "flow", None)
+    return 0 if flow is None else int(flow.pad())
+
+
 FILTERS: Mapping[str, Filter] = {
     **Post.FILTERS,
+    "ur_flow": _flow_filter,
+    "ur_pad": _pad_filter,
     "ur_pose": ur_pose,
     "ur_joints": ur_joints,
     "ur_via": _via_filter,
@@ -270,11 +293,49 @@ class UrPost(Post):
     FILTERS: ClassVar[Mapping[str, Filter]] = FILTERS
     TRANSFORMS = (cap_blend_radii,)
     ARC_ORIENTATIONS = frozenset({ArcOrientation.INTERPOLATE, ArcOrientation.PATH_CONSTANT})
+    WRITES_FLOW = True
+
+    def __init__(self, manifest: Any) -> None:
+        super().__init__(manifest)
+        self.flow: UrWriter | None = None
+        """The flow writer of the file being rendered (made by :meth:`context_values`)."""
+
+    def writer(self, nodes: Sequence[Any]) -> UrWriter:
+        """A :class:`~olp.posts.ur_flow.UrWriter` for a program's statements."""
+        return UrWriter(Symbols(nodes), NAME_RULE, POST_BUILTINS)
+
+    def check(self, compiled: CompiledProgram) -> list[Diagnostic]:
+        """The base checks; a program with control flow needs a template folder that writes
+        it (option ``writes_flow``, see the module docstring)."""
+        if compiled.program.has_flow and not self.options.get("writes_flow"):
+            error = self._flow_error(compiled)
+            hint = "use the bundled ur post, or a copy made since olp writes URScript control flow"
+            error = dataclasses.replace(
+                error,
+                message=error.message.replace("does not write", "folder does not declare")
+                + " (option writes_flow)",
+                hint=hint,
+            )
+            return [*self._foreign_robot(compiled), error]
+        return super().check(compiled)
+
+    def reserved_names(self, compiled: CompiledProgram) -> Sequence[str]:
+        """The program's variable names (:class:`~olp.posts.flow_text.Symbols`)."""
+        return list(Symbols(compiled.program.instructions).spelling.values())
+
+    def context_values(self, steps: Sequence[PostStep]) -> Mapping[str, Any]:
+        """The flow writer of this file (``vendor.flow_kinds``: the steps it writes)."""
+        self.flow = self.writer([s.instruction for s in steps if s.kind == "declare"])
+        self.flow.prepare(steps)
+        return {"flow_kinds": FLOW_STEP_KINDS}
 
     def check_program(self, compiled: CompiledProgram) -> list[Diagnostic]:
         """``program_too_long`` (warning): more than :data:`MAX_MOTIONS` motions;
-        ``arc_blend`` (error): blends at arcs the controller refuses (module docstring)."""
-        found = arc_blends(compiled)
+        ``arc_blend`` (error): blends at arcs the controller refuses (module docstring);
+        ``flow`` (error): a control-flow statement or declaration URScript cannot hold
+        exactly (:mod:`olp.posts.ur_flow`)."""
+        nodes = compiled.program.instructions
+        found = flow_problems(nodes, self.writer(nodes)) + arc_blends(compiled)
         motions = sum(1 for s in compiled.steps if s.joints is not None)
         if motions <= MAX_MOTIONS:
             return found
