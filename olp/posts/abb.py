@@ -418,7 +418,7 @@ class AbbPost(Post):
             if zname not in PREDEFINED_NAMES:
                 zones.setdefault(zname, zonedata(self, step.zone))
         self.current_step = None
-        flow = self.flow = self.writer([s.instruction for s in steps if s.kind == "declare"])
+        flow = self.flow = self.writer([s.instruction for s in steps if s.kind in FLOW_STEP_KINDS])
         flow.prepare(steps)
         return {
             "speeds": [{"name": k, "value": v} for k, v in speeds.items()],

@@ -57,9 +57,8 @@ MARKER_KINDS = (
     *("end_while", "repeat", "until", "loop", "end_loop", "for", "end_for"),
 )
 """The kinds of :func:`olp.posts.flow.weave`'s marker steps."""
-FLOW_STEP_KINDS = (
-    *MARKER_KINDS,
-    *("declare", "assign", "wait_until", "label", "goto", "exit", "return"),
+FLOW_STEP_KINDS = frozenset(
+    (*MARKER_KINDS, "declare", "assign", "wait_until", "label", "goto", "exit", "return")
 )
 """Every step kind a :class:`FlowWriter` writes (a template hands these to it)."""
 

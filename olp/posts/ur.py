@@ -325,7 +325,7 @@ class UrPost(Post):
 
     def context_values(self, steps: Sequence[PostStep]) -> Mapping[str, Any]:
         """The flow writer of this file (``vendor.flow_kinds``: the steps it writes)."""
-        self.flow = self.writer([s.instruction for s in steps if s.kind == "declare"])
+        self.flow = self.writer([s.instruction for s in steps if s.kind in FLOW_STEP_KINDS])
         self.flow.prepare(steps)
         return {"flow_kinds": FLOW_STEP_KINDS}
 
