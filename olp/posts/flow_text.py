@@ -206,7 +206,7 @@ def names_of(node: Any) -> Iterator[str]:
 
 def exprs_of(node: Any) -> list[Any]:
     """The expressions of one statement or block head (not of its bodies)."""
-    fields = ("condition", "value", "target", "subject", "start", "stop", "step", "until")
+    fields = ("target", "condition", "value", "subject", "start", "stop", "step", "until")
     found = [getattr(node, f, None) for f in fields] + list(getattr(node, "dims", ()))
     found += [b.condition for b in getattr(node, "branches", ())]
     found += [v for c in getattr(node, "cases", ()) for v in c.values]

@@ -69,7 +69,9 @@ Python's shortest round-trip form (finite, within num's range); strings in doubl
 printable ASCII, at most 80 characters, without ``"`` or ``\\`` (RAPID writes those as ``""``
 and ``\\\\``, as recalled; olp refuses them rather than rely on it). A digital input is the
 comparison ``(di5 = 1)`` with the post's signal names (option ``input_signal``). Names must be
-legal RAPID identifiers (the post's name rule): KRL's ``$`` system variables are errors.
+legal RAPID identifiers (the post's name rule): KRL's ``$`` system variables are errors, and so
+is a name of RAPID's predefined data or of the speed and zone data olp writes (``tool0``,
+``fine``, ``v100``, ``z10``), which a program variable would hide.
 """
 
 from __future__ import annotations
@@ -120,6 +122,8 @@ _MEMBERS = {
     "pose": {"X": "trans.x", "Y": "trans.y", "Z": "trans.z"},
     "joints": {f"A{k}": f"robax.rax_{k}" for k in range(1, 7)},
 }
+_MOTION_DATA = re.compile(r"[vVzZ]\d+(_\d+)?(_o\d+(_\d+)?)?\Z")
+"""The names olp gives speed and zone data (``v100``, ``v21_17``, ``z12_5``, ``v100_o30``)."""
 _TEXT = re.compile(r"[ !#-\[\]-~]*\Z")
 """Printable ASCII without ``"`` and ``\\``."""
 
@@ -138,6 +142,7 @@ class RapidWriter(FlowWriter):
         taken: Iterable[str] = (),
     ) -> None:
         super().__init__(symbols, taken)
+        self.forbidden = {t.casefold() for t in taken}
         self.rule = rule
         self.input_signal = input_signal
         self.flags: dict[int, str] = {}
@@ -206,6 +211,11 @@ class RapidWriter(FlowWriter):
         spelled = self.symbols.name(name)
         if not self.rule.is_legal(spelled):
             raise FlowProblem(f"{spelled!r} is not a RAPID name")
+        if spelled.casefold() in self.forbidden or _MOTION_DATA.match(spelled):
+            raise FlowProblem(
+                f"{spelled} is the name of RAPID's or olp's own data (tool0, fine, v100, z10 "
+                "...), which a variable of the program would hide"
+            )
         return spelled
 
     def expr(self, expr: ir.Expr | None, nested: bool = False) -> str:

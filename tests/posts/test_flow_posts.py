@@ -388,6 +388,13 @@ def test_settings_after_a_block_boundary(station: Any) -> None:
     ]
 
 
+def test_urscript_names_are_written_as_declared(station: Any) -> None:
+    """KRL names are case-insensitive, URScript's are not: one spelling per variable."""
+    prog = program(declare("nCount", "INT"), assign(name("NCOUNT"), const(1)))
+    prog = ir.Program(name="t", instructions=(*prog.instructions, assign(name("Foo"), name("FOO"))))
+    assert body(build(station, prog, "ur")) == ["  local nCount = 0", "  nCount = 1", "  Foo = Foo"]
+
+
 def test_generated_names_avoid_the_programs_names(station: Any) -> None:
     """A variable named like a point olp would generate (p2) keeps its name; the point moves."""
     prog = program(declare("p2", "INT"), assign(name("p2"), const(1)), lin(0.5, 9))
@@ -533,7 +540,7 @@ def test_strings_cannot_become_live_lines(station: Any, post: str, text: str) ->
 
 
 NAMES = [
-    *(("abb", t) for t in ["a; MoveL p1", "a\nb", "WHILE", "x y", "ENDPROC"]),
+    *(("abb", t) for t in ["a; MoveL p1", "a\nb", "WHILE", "x y", "ENDPROC", "v300", "fine"]),
     *(("ur", t) for t in ["a; movel(p)", "a\nb", "while", "x y", "movel", "end"]),
 ]
 
