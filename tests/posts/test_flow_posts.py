@@ -573,3 +573,36 @@ def test_cli_drops_foreign_verbatim_lines_with_a_warning(
     assert "warning[verbatim_dropped]" in text and "'HALT' (line 4)" in text
     written = (tmp_path / "b" / "halt.mod").read_text()
     assert "HALT" not in written and "IF (di1 = 1) THEN" in written
+
+
+# --------------------------------------------------------------------------------------------
+# URScript blends around blocks
+
+
+def test_capped_blends_keep_the_blocks(station: Any, tmp_path: Path) -> None:
+    """Capping blend radii rewrites motions inside a block: the block stays (a flat program
+    would write the IF's body unconditionally)."""
+    src = tmp_path / "capped.src"
+    src.write_text(
+        "DEF capped( )\n$TOOL=TOOL_DATA[1]\n$BASE=BASE_DATA[1]\n$VEL.CP=0.3\n$APO.CDIS=20.0\n"
+        "PTP {A1 107.78,A2 -44.95,A3 141.65,A4 107.67,A5 -87.93,A6 6.38}\nIF $IN[1] THEN\n"
+        "  LIN {X 50.0,Y 50.0,Z 100.0,A 180.0,B 0.0,C 180.0} C_DIS\n"
+        "  LIN {X 55.0,Y 50.0,Z 100.0,A 180.0,B 0.0,C 180.0} C_DIS\n"
+        "  LIN {X 150.0,Y 50.0,Z 100.0,A 180.0,B 0.0,C 180.0}\nENDIF\nEND\n"
+    )
+    result = build(station, src, "ur")
+    assert any(d.kind == "blend_capped" for d in result.diagnostics)
+    lines = [line.strip() for line in body(result)]
+    assert lines[0] == "if get_digital_in(1):" and lines[-1] == "end"
+    assert [line[-11:] for line in lines[1:-1]] == ["r=0.002500)", "r=0.002500)", "r=0.000000)"]
+
+
+def test_no_urscript_blend_reaches_across_a_block_boundary(station: Any) -> None:
+    """The last movel of a WHILE's body blends into a motion known only at run time: written
+    with r = 0 and a warning; the blend inside the body stays."""
+    result = build(station, FLOW / "flow_loops.src", "ur")
+    stopped = [d for d in result.diagnostics if d.kind == "blend_stopped"]
+    assert [(d.severity, d.span.line if d.span else 0) for d in stopped] == [("warning", 27)]
+    lines = [line.strip() for line in body(result)]
+    start = lines.index("while not get_digital_in(2):")
+    assert [line[-11:] for line in lines[start + 1 : start + 3]] == ["r=0.005000)", "r=0.000000)"]
