@@ -51,8 +51,9 @@ Expressions
 and needs no ``xor``, whose spelling in URScript is unverified); ``==``, ``!=`` for ``<>``,
 ``<``, ``<=``, ``>``, ``>=``, ``+``, ``-``, ``*``; every nested operation in parentheses.
 ``/`` only where one side is known to be a real (KRL divides INT by INT with truncation; what
-URScript's ``/`` does with two ints is unverified). ``True``/``False``; numbers in Python's
-shortest round-trip form; strings in double quotes, printable ASCII without ``"`` or ``\\``
+URScript's ``/`` does with two ints is unverified). ``True``/``False``; numbers in the shortest
+form that reads back to the same value, without an exponent (``0.00001``: URScript's exponent
+notation is unverified); strings in double quotes, printable ASCII without ``"`` or ``\\``
 (URScript's escapes are unverified: refused rather than guessed). A digital input is
 ``get_digital_in(n)``, as the post reads inputs (numbers 0..9). Names are written as the
 program declares them (URScript names are case-sensitive, KRL's are not) and must be legal
@@ -66,6 +67,8 @@ import math
 import re
 from collections.abc import Iterable, Sequence
 from typing import Any, ClassVar
+
+import numpy as np
 
 from olp import ir
 from olp.posts.flow_text import (
@@ -197,7 +200,7 @@ class UrWriter(FlowWriter):
         if isinstance(value, float):
             if not math.isfinite(value):
                 raise FlowProblem(f"{value} is not a number URScript can hold")
-            return repr(value)
+            return np.format_float_positional(value, unique=True, trim="0")
         if not _TEXT.match(value):
             raise FlowProblem(
                 f"the text {value!r} holds a double quote, a backslash or a character that is "

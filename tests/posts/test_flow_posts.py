@@ -154,6 +154,12 @@ STATEMENTS: list[tuple[str, Any, str, str]] = [
         "while not (r >= 2.5):\n  sync()\nend",
     ),
     ("return", ir.Return(), "RETURN;", "return"),
+    (
+        "small and large reals",
+        assign(R, ir.BinaryOp(op="+", left=const(1e-05), right=const(1e20))),
+        "r := 1e-05 + 1e+20;",
+        "r = 0.00001 + 100000000000000000000.0",
+    ),
 ]
 
 
