@@ -46,7 +46,7 @@ the confidence given:
   ``\\`` (RAPID strings hold 80 characters, medium confidence; a backslash starts a character
   code).
 * Control flow and data (:mod:`olp.ir_flow`): :mod:`olp.posts.rapid_flow`, with its sources.
-  A template folder writes them only if its options say ``writes_flow: true`` (the bundled one
+  A template folder writes them only if its ``post.yaml`` says ``flow: true`` (the bundled one
   does): a folder copied before would write every block's body unconditionally, so a program
   with control flow stops on such a folder with an error (``control_flow``).
 * Work objects are given in the controller's world frame, which on a delivered single-robot
@@ -375,14 +375,14 @@ class AbbPost(Post):
 
     def check(self, compiled: CompiledProgram) -> list[Diagnostic]:
         """The base checks; a program with control flow needs a template folder that writes
-        it (option ``writes_flow``, see the module docstring)."""
-        if compiled.program.has_flow and not self.options.get("writes_flow"):
+        it (``flow: true`` in its ``post.yaml``, see the module docstring)."""
+        if compiled.program.has_flow and not self.manifest.flow:
             error = self._flow_error(compiled)
             hint = "use the bundled abb post, or a copy made since olp writes RAPID control flow"
             error = dataclasses.replace(
                 error,
                 message=error.message.replace("does not write", "folder does not declare")
-                + " (option writes_flow)",
+                + " (flow: true in its post.yaml)",
                 hint=hint,
             )
             return [*self._foreign_robot(compiled), error]

@@ -55,7 +55,7 @@ Conventions shared with frontends (rotation vectors, the flange, no configuratio
   1 µm and checked to 10 µm, speeds and accelerations must stay positive once printed, and a
   ``sleep`` above :data:`MAX_SLEEP` s is refused (olp's bound; URScript states none).
 * Control flow and data (:mod:`olp.ir_flow`): :mod:`olp.posts.ur_flow`, with its sources. A
-  template folder writes them only if its options say ``writes_flow: true`` (the bundled one
+  template folder writes them only if its ``post.yaml`` says ``flow: true`` (the bundled one
   does): a folder copied before would write every block's body unconditionally, so a program
   with control flow stops on such a folder with an error (``control_flow``).
 * Comments: ``#`` to the end of the line, whitespace collapsed; a comment of several lines
@@ -325,8 +325,8 @@ def _stop_warning(step: Any) -> Diagnostic:
         "blend_stopped",
         f"blend radius {ins.zone.radius * 1000:.1f} mm written as 0 (the robot stops here): the "
         "next motion is beyond a block boundary, known only at run time, so olp cannot keep "
-        "the blends from overlapping (the controller would skip a move); the cycle time "
-        "estimate blends it",
+        "the blends from overlapping (the controller would skip a move); the cycle time per "
+        "path times it as a stop too",
         ins.span,
         step.index,
     )
@@ -399,14 +399,14 @@ class UrPost(Post):
 
     def check(self, compiled: CompiledProgram) -> list[Diagnostic]:
         """The base checks; a program with control flow needs a template folder that writes
-        it (option ``writes_flow``, see the module docstring)."""
-        if compiled.program.has_flow and not self.options.get("writes_flow"):
+        it (``flow: true`` in its ``post.yaml``, see the module docstring)."""
+        if compiled.program.has_flow and not self.manifest.flow:
             error = self._flow_error(compiled)
             hint = "use the bundled ur post, or a copy made since olp writes URScript control flow"
             error = dataclasses.replace(
                 error,
                 message=error.message.replace("does not write", "folder does not declare")
-                + " (option writes_flow)",
+                + " (flow: true in its post.yaml)",
                 hint=hint,
             )
             return [*self._foreign_robot(compiled), error]

@@ -516,12 +516,12 @@ def test_rapid_for_counter_outside_its_loop(station: Any) -> None:
 
 
 def test_a_folder_copied_before_flow_stops_on_control_flow(station: Any, tmp_path: Path) -> None:
-    """A template folder without ``writes_flow`` would write each block's body unconditionally."""
+    """A template folder without ``flow: true`` would write each block's body unconditionally."""
     for post in ("abb", "ur"):
         folder = tmp_path / post
         shutil.copytree(REPO / "posts" / post, folder)
         manifest = folder / "post.yaml"
-        manifest.write_text(manifest.read_text().replace("writes_flow: true", "writes_flow: false"))
+        manifest.write_text(manifest.read_text().replace("\nflow: true", "\nflow: false"))
         result = build(station, FLOW / "flow_loops.src", str(folder))
         assert [k for k, _ in errors(result)] == ["control_flow"] and not result.files
 
