@@ -30,6 +30,9 @@ Blocks
 * A wait on a condition polls once per control cycle: ``while not (c):`` ``sync()`` ``end``,
   as the post already waits for an input.
 * Labels and GOTO: URScript has no jump; they are an error naming the line.
+* A block whose body is empty (a KRL ``IF`` with only an ``ELSE`` body, a dropped line) is
+  written empty (``if c:`` then ``else:``); whether URScript accepts an empty body is
+  unverified (a script it refuses does not run: no motion follows from it).
 
 Data
 ----
