@@ -11,10 +11,12 @@ from olp.commands.options import (
     add_check_options,
     add_collision_options,
     add_output_options,
+    add_post_options,
     add_program,
     add_program_options,
     build_options,
     check_report_paths,
+    post_writer,
     program_options,
     write_outputs,
 )
@@ -26,7 +28,7 @@ HELP = "compile a program on a station and write robot code"
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("station", help="station YAML file")
     add_program(parser)
-    parser.add_argument("--post", default="kuka", help="post name or folder (default: kuka)")
+    add_post_options(parser)
     parser.add_argument("-o", "--out", default="out", help="output folder (default: out)")
     parser.add_argument("--name", help="program name in the output (default: from the source)")
     add_output_options(parser)
@@ -49,7 +51,7 @@ def run(args: argparse.Namespace) -> int:
         result = build(
             args.station,
             args.program,
-            post=args.post,
+            post=post_writer(args),
             out_dir=args.out,
             name=args.name,
             options=options,

@@ -4,6 +4,7 @@
 * ``--assume`` (what a program's branches and loops may take as known) -> :func:`build_options`;
 * collision options (``--no-collisions``, ``--clearance`` ...) -> :func:`collision_options`;
 * output options (``--report``, ``--sarif``) -> :func:`check_report_paths`, :func:`write_outputs`;
+* post options (``--post``, ``--drop-foreign-verbatim``) -> :func:`post_writer`;
 * the program and its options: one argument group per set of frontends that take the same flags,
   built from the frontends' ``Options`` dataclasses (:mod:`olp.frontends.options`), so a new
   frontend brings its flags with it. The values go to the frontend of the program's suffix
@@ -185,6 +186,32 @@ def write_outputs(args: argparse.Namespace, result: BuildResult) -> None:
         write_file(args.report, report_json(result).encode("utf-8"))
     if getattr(args, "sarif", None):
         write_file(args.sarif, sarif_json(result.diagnostics, version("olp")).encode("utf-8"))
+
+
+# ------------------------------------------------------------------------------------------------
+# Post options
+
+
+def add_post_options(parser: argparse.ArgumentParser) -> None:
+    """``--post`` and ``--drop-foreign-verbatim``."""
+    parser.add_argument("--post", default="kuka", help="post name or folder (default: kuka)")
+    parser.add_argument(
+        "--drop-foreign-verbatim",
+        action="store_true",
+        help="leave out the statements olp kept verbatim in another language than the post's "
+        "(a KRL line for the abb post), each with a warning showing its text, instead of "
+        "stopping with an error (the post option foreign_verbatim: drop)",
+    )
+
+
+def post_writer(args: argparse.Namespace) -> Any:
+    """The post ``--post`` names: its name, or with ``--drop-foreign-verbatim`` the loaded post
+    with the option ``foreign_verbatim: drop`` (:func:`olp.posts.find_post`)."""
+    if not getattr(args, "drop_foreign_verbatim", False):
+        return args.post
+    from olp.posts import find_post
+
+    return find_post(args.post, {"foreign_verbatim": "drop"})
 
 
 # ------------------------------------------------------------------------------------------------

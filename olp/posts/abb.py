@@ -45,6 +45,10 @@ the confidence given:
 * Call arguments: numbers, names, and ``"strings"`` of at most 80 characters without ``"`` or
   ``\\`` (RAPID strings hold 80 characters, medium confidence; a backslash starts a character
   code).
+* Control flow and data (:mod:`olp.ir_flow`): :mod:`olp.posts.rapid_flow`, with its sources.
+  A template folder writes them only if its ``post.yaml`` says ``flow: true`` (the bundled one
+  does): a folder copied before would write every block's body unconditionally, so a program
+  with control flow stops on such a folder with an error (``control_flow``).
 * Work objects are given in the controller's world frame, which on a delivered single-robot
   controller is the robot's base frame (post manifest ``frames_in: robot_base``).
 """
@@ -58,10 +62,14 @@ from typing import TYPE_CHECKING, Any, ClassVar
 import numpy as np
 from numpy.typing import ArrayLike
 
+from olp import ir
 from olp.diagnostics import Diagnostic
 from olp.errors import PostError
+from olp.ir_flow import leaves_and_blocks
 from olp.posts.base import Filter, Post
+from olp.posts.flow_text import FLOW_STEP_KINDS, Symbols, flow_problems, jump_problems
 from olp.posts.numbers import NumberFormat, Storage
+from olp.posts.rapid_flow import RapidWriter, counter_problems
 from olp.posts.sandbox import SafeText
 from olp.posts.text import IDENTIFIER, NUMBER, ArgumentRule, NameRule, one_of
 from olp.vendors.abb import confdata, normalised_rounded, pose_to_robtarget
@@ -300,8 +308,24 @@ def _confdata_filter(post: Post, joints: ArrayLike, robot: Any) -> str:
     return rapid_confdata(confdata(robot, joints))
 
 
+def _flow_filter(post: Post, step: PostStep) -> SafeText:
+    """Template filter: ``s | rapid_flow``, the lines of a marker or flow statement
+    (:class:`olp.posts.rapid_flow.RapidWriter`), indented."""
+    assert isinstance(post, AbbPost) and post.flow is not None
+    return post.flow.lines(step)
+
+
+def _pad_filter(post: Post, step: Any) -> int:
+    """Template filter: ``s | rapid_pad``, the extra indentation of an ordinary statement inside
+    blocks (0 outside any)."""
+    flow = getattr(post, "flow", None)
+    return 0 if flow is None else int(flow.pad())
+
+
 FILTERS: Mapping[str, Filter] = {
     **Post.FILTERS,
+    "rapid_flow": _flow_filter,
+    "rapid_pad": _pad_filter,
     "rapid_pose": rapid_pose,
     "rapid_robtarget": _robtarget_filter,
     "rapid_jointtarget": rapid_jointtarget,
@@ -336,6 +360,23 @@ class AbbPost(Post):
     NULL_TOOL_NAME = NULL_TOOL_NAME
     NULL_FRAME_NAME = NULL_FRAME_NAME
     PREDEFINED_NAMES = PREDEFINED_NAMES
+    WRITES_FLOW = True
+
+    def __init__(self, manifest: Any) -> None:
+        super().__init__(manifest)
+        self.flow: RapidWriter | None = None
+        """The flow writer of the file being rendered (made by :meth:`context_values`)."""
+
+    def writer(self, nodes: Sequence[Any]) -> RapidWriter:
+        """A :class:`~olp.posts.rapid_flow.RapidWriter` for a program's statements."""
+        signal = str(self.options.get("input_signal", "di{index}"))
+        return RapidWriter(Symbols(nodes), NAME_RULE, signal, PREDEFINED_NAMES)
+
+    def reserved_names(self, compiled: CompiledProgram) -> Sequence[str]:
+        """The program's variable names and labels (:class:`~olp.posts.flow_text.Symbols`)."""
+        nodes = compiled.program.instructions
+        labels = [n.name for n in leaves_and_blocks(nodes) if isinstance(n, ir.Label)]
+        return [*Symbols(nodes).spelling.values(), *labels]
 
     def step_values(self, robot: Any, joints: Any) -> list[Mapping[str, Any]]:
         """The confdata ``(cf1, cf4, cf6, cfx)`` of each motion's planned joints (N, 6)."""
@@ -361,9 +402,14 @@ class AbbPost(Post):
             if zname not in PREDEFINED_NAMES:
                 zones.setdefault(zname, zonedata(self, step.zone))
         self.current_step = None
+        flow = self.flow = self.writer([s.instruction for s in steps if s.kind in FLOW_STEP_KINDS])
+        flow.prepare(steps)
         return {
             "speeds": [{"name": k, "value": v} for k, v in speeds.items()],
             "zones": [{"name": k, "value": v} for k, v in zones.items()],
+            "flow_kinds": FLOW_STEP_KINDS,
+            "routine_data": flow.declarations(exported=False),
+            "module_data": flow.declarations(exported=True),
         }
 
     def check_instruction(self, step: Step, compiled: CompiledProgram) -> list[Diagnostic]:
@@ -386,8 +432,11 @@ class AbbPost(Post):
 
     def check_program(self, compiled: CompiledProgram) -> list[Diagnostic]:
         """``tool_load`` (warning, once per tool): the tooldata's load is a placeholder (no
-        mass or centre of gravity in the station)."""
-        out: list[Diagnostic] = []
+        mass or centre of gravity in the station); ``flow`` (error): a control-flow statement
+        or declaration RAPID cannot hold exactly (:mod:`olp.posts.rapid_flow`)."""
+        nodes = compiled.program.instructions
+        extra = [*jump_problems(nodes), *counter_problems(nodes)]
+        out: list[Diagnostic] = flow_problems(nodes, self.writer(nodes), extra)
         loads: set[str] = set()
         for step in compiled.steps:
             ins: Any = step.instruction

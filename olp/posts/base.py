@@ -29,9 +29,9 @@ What every post checks (:meth:`Post.check`), so that no brand can forget it:
 * digital I/O numbers within the controller's range (``IO_RANGE``, ``io_range``);
 * a station robot of another brand than the post's (a warning, ``foreign_robot``);
 * a :class:`~olp.ir.Verbatim` statement of another language than the post's ``VERBATIM`` is an
-  error naming its line (``verbatim``); with the template folder's option
-  ``foreign_verbatim: drop`` it is left out with a warning showing its text
-  (``verbatim_dropped``).
+  error naming its line (``verbatim``); with the post option ``foreign_verbatim: drop`` (in a
+  template folder, or ``olp build --drop-foreign-verbatim``) it is left out with a warning
+  showing its text (``verbatim_dropped``).
 
 Numbers are written through :meth:`Post.number` with a quantity of ``NUMBERS``
 (:mod:`olp.posts.numbers`): a value the controller cannot hold as checked and timed is an error on
@@ -138,7 +138,9 @@ class Post:
     WRITES_FLOW: ClassVar[bool] = False
     """Whether the templates write control flow and data statements (:mod:`olp.ir_flow`); a
     post that does not stops on a program holding them, naming the first one, rather than
-    writing its instructions in a row."""
+    writing its instructions in a row. So does a template folder whose ``post.yaml`` does not
+    say ``flow: true`` (a copy made before olp wrote control flow would write each block's body
+    unconditionally)."""
     VERBATIM: ClassVar[str | None] = None
     """The language of :class:`~olp.ir.Verbatim` statements this post writes unchanged (KUKA:
     ``"krl"``); a verbatim statement of another language is an error on its line."""
@@ -207,6 +209,11 @@ class Post:
         """What this language cannot say exactly about the whole program."""
         return []
 
+    def reserved_names(self, compiled: CompiledProgram) -> Sequence[str]:
+        """Names the program's own statements use (variables, labels), which the names olp
+        makes up for points, tools and frames must not take; none by default."""
+        return ()
+
     # ----------------------------------------------------------------------------------------
     # The pipeline
 
@@ -221,7 +228,7 @@ class Post:
     def check(self, compiled: CompiledProgram) -> list[Diagnostic]:
         """Everything this post reports about ``compiled``; errors mean nothing is written."""
         out = self._foreign_robot(compiled)
-        if compiled.program.has_flow and not self.WRITES_FLOW:
+        if compiled.program.has_flow and not (self.WRITES_FLOW and self.manifest.flow):
             return [*out, self._flow_error(compiled)]
         compiled = compiled.flat()
         for step in compiled.steps:
@@ -438,13 +445,20 @@ class Post:
             n for n in leaves_and_blocks(compiled.program.instructions) if isinstance(n, FLOW_TYPES)
         )
         what = first.kind.replace("_", " ")
-        return Diagnostic(
-            "error",
-            "control_flow",
-            f"the {self.LANGUAGE} post does not write control flow and data statements yet "
-            f"(first: {what} at line {first.span.line}); nothing of the program is written",
-            first.span,
+        where = f"(first: {what} at line {first.span.line}); nothing of the program is written"
+        if not self.WRITES_FLOW:
+            message = f"the {self.LANGUAGE} post does not write control flow and data statements"
+            return Diagnostic("error", "control_flow", f"{message} yet {where}", first.span)
+        message = (
+            f"the {self.LANGUAGE} post's template folder {self.manifest.folder.name} does not "
+            "declare that it writes control flow and data statements (flow: true in its "
+            f"post.yaml) {where}"
         )
+        hint = (
+            f"use the bundled {self.NAME} post, or a copy made since olp writes "
+            f"{self.LANGUAGE} control flow"
+        )
+        return Diagnostic("error", "control_flow", message, first.span, hint=hint)
 
     def _verbatim_checks(self, step: Step, ins: Any) -> list[Diagnostic]:
         """A statement kept as source text goes out unchanged to its own language only; it was
@@ -453,7 +467,10 @@ class Post:
             return self._encoding_checks(step, "verbatim", ins.text)
         what = f"{ins.language.upper()} statement {_quote(ins.text)} (line {ins.span.line})"
         if self.options.get("foreign_verbatim") == "drop":
-            msg = f"{what} is not written: the option foreign_verbatim: drop leaves it out"
+            msg = (
+                f"{what} is not written: foreign_verbatim: drop (olp build "
+                "--drop-foreign-verbatim) leaves it out"
+            )
             return [Diagnostic("warning", "verbatim_dropped", msg, ins.span, step.index)]
         msg = (
             f"{what} is kept verbatim because olp does not model it ({ins.reason}); the "
@@ -461,7 +478,8 @@ class Post:
         )
         hint = (
             "write it for this controller by hand, remove it from the source program, or leave "
-            "it out with a warning: the post option foreign_verbatim: drop (in a copy of the post)"
+            "it out with a warning: olp build --drop-foreign-verbatim (the post option "
+            "foreign_verbatim: drop)"
         )
         return [_error("verbatim", msg, step, hint=hint)]
 

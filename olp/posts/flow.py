@@ -127,12 +127,13 @@ def _fresh_after_boundaries(steps: Sequence[PostStep]) -> Iterator[PostStep]:
             continue
         speed = "joint" if step.kind == "joint" else "linear"
         fresh = speed in stale
+        tool, frame, zone = ("tool" in stale), ("frame" in stale), ("zone" in stale)
         stale -= {"tool", "frame", "zone", speed}
         yield dataclasses.replace(
             step,
-            new_tool=True,
-            new_frame=True,
-            new_zone=True,
+            new_tool=step.new_tool or tool,
+            new_frame=step.new_frame or frame,
+            new_zone=step.new_zone or zone,
             new_joint_speed=step.new_joint_speed or (fresh and speed == "joint"),
             new_linear_speed=step.new_linear_speed or (fresh and speed == "linear"),
         )

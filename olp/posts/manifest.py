@@ -23,6 +23,10 @@ The manifest says::
                                       # class can (default false: a folder copied before olp
                                       # wrote them; the post then warns where a program sets
                                       # one)
+    flow: true                        # the templates write control flow and data (default
+                                      # false: a folder copied before olp wrote them, which
+                                      # would write every block's body unconditionally; a post
+                                      # that checks it stops on a program with control flow)
     options: {...}                    # free-form: templates see them as `options`, and so does
                                       # the post class
 
@@ -64,6 +68,7 @@ class PostManifest:
     frames_in: str = "world"
     rows: bool = False
     accelerations: bool = False
+    flow: bool = False
 
 
 def load_manifest(folder: Path) -> PostManifest:
@@ -81,7 +86,7 @@ def load_manifest(folder: Path) -> PostManifest:
     frames_in = str(raw.get("frames_in", "world"))
     if frames_in not in FRAMES_IN:
         raise PostError(f"{path}: frames_in must be one of {', '.join(FRAMES_IN)}")
-    rows, accelerations = (_flag(raw, key, path) for key in ("rows", "accelerations"))
+    rows, accelerations, flow = (_flag(raw, key, path) for key in ("rows", "accelerations", "flow"))
     return PostManifest(
         name=str(raw.get("name", folder.name)),
         vendor=str(raw.get("vendor", "")),
@@ -96,6 +101,7 @@ def load_manifest(folder: Path) -> PostManifest:
         frames_in=frames_in,
         rows=rows,
         accelerations=accelerations,
+        flow=flow,
     )
 
 

@@ -180,7 +180,8 @@ class _Renderer:
         split = len(parts) > 1
         rule = self.rule
         unit_names = part_names(self.name, len(parts), rule.legal, rule.max_length) if split else []
-        names = Names(rule, [self.name, *unit_names, *self.post.PREDEFINED_NAMES])
+        reserved = [*self.post.PREDEFINED_NAMES, *self.post.reserved_names(self.compiled)]
+        names = Names(rule, [self.name, *unit_names, *reserved])
         options = self.manifest.options
         entry = names.take(str(options["entry"])) if "entry" in options else self.name
         routines = [

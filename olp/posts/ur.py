@@ -39,7 +39,9 @@ Conventions shared with frontends (rotation vectors, the flange, no configuratio
   (the blend would cut the arc before its defining point; olp's rule, like the overlapping
   blends the controller skips).
 * ``r`` (m): the zone radius capped by :mod:`olp.transforms.blend` (neighbouring blends must not
-  overlap, ``r = 0`` where the robot stops; project vendor notes).
+  overlap, ``r = 0`` where the robot stops; project vendor notes); in a program with control
+  flow, ``r = 0`` where the next motion lies beyond a block boundary
+  (:func:`stop_at_block_boundaries`).
 * ``set_tcp(p[...])``: the tool's TCP in the flange frame, before the first motion with it.
 * ``set_digital_out(n, b)``, ``get_digital_in(n)`` polled with ``sync()`` for an input wait,
   ``sleep(s)``; output and input numbers 0..9 (e-Series script manual: ``set_digital_out``
@@ -52,25 +54,36 @@ Conventions shared with frontends (rotation vectors, the flange, no configuratio
 * Numbers: URScript's float width is unverified (believed 64-bit); positions are written to
   1 µm and checked to 10 µm, speeds and accelerations must stay positive once printed, and a
   ``sleep`` above :data:`MAX_SLEEP` s is refused (olp's bound; URScript states none).
+* Control flow and data (:mod:`olp.ir_flow`): :mod:`olp.posts.ur_flow`, with its sources. A
+  template folder writes them only if its ``post.yaml`` says ``flow: true`` (the bundled one
+  does): a folder copied before would write every block's body unconditionally, so a program
+  with control flow stops on such a folder with an error (``control_flow``).
 * Comments: ``#`` to the end of the line, whitespace collapsed; a comment of several lines
   becomes several ``#`` lines.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import itertools
 import re
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping, Sequence
 from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from olp import ir
 from olp.diagnostics import Diagnostic
 from olp.ir import ArcOrientation
+from olp.ir_flow import bodies
 from olp.posts.base import Filter, Post
+from olp.posts.flow_text import FLOW_STEP_KINDS, Symbols, flow_problems
 from olp.posts.numbers import NumberFormat
 from olp.posts.sandbox import SafeText
 from olp.posts.text import NUMBER, ArgumentRule, CommentRule, NameRule
+from olp.posts.ur_flow import UrWriter
+from olp.transforms.blend import with_step_instructions
 from olp.vendors.ur import (
     MOTION_DECIMALS,
     movej_parameters,
@@ -226,8 +239,24 @@ def _blends_filter(post: Post, steps: Any, station: Any) -> dict[int, float]:
     return {c.index: c.radius for c in blend_radii(list(steps), robot, robot.home)}
 
 
+def _flow_filter(post: Post, step: PostStep) -> SafeText:
+    """Template filter: ``s | ur_flow``, the lines of a marker or flow statement
+    (:class:`olp.posts.ur_flow.UrWriter`), indented ('' for a marker that writes nothing)."""
+    assert isinstance(post, UrPost) and post.flow is not None
+    return post.flow.lines(step)
+
+
+def _pad_filter(post: Post, step: Any) -> int:
+    """Template filter: ``s | ur_pad``, the extra indentation of an ordinary statement inside
+    blocks (0 outside any)."""
+    flow = getattr(post, "flow", None)
+    return 0 if flow is None else int(flow.pad())
+
+
 FILTERS: Mapping[str, Filter] = {
     **Post.FILTERS,
+    "ur_flow": _flow_filter,
+    "ur_pad": _pad_filter,
     "ur_pose": ur_pose,
     "ur_joints": ur_joints,
     "ur_via": _via_filter,
@@ -254,6 +283,93 @@ def cap_blend_radii(
     return capped, list(found)
 
 
+def stop_at_block_boundaries(
+    compiled: CompiledProgram, post: Post
+) -> tuple[CompiledProgram, list[Diagnostic]]:
+    """The transform for programs with control flow: a motion whose next motion in the text lies
+    beyond a block boundary (an ``if``, ``else``, ``end``, a loop's turn, a label, a jump, an
+    exit or a return) is written with ``r = 0``, with a warning (``blend_stopped``). Which motion
+    follows it is known only at run time, so olp cannot cap its blend against its neighbour's,
+    and the controller skips a move whose blend overlaps its neighbour's (project vendor notes,
+    as for :func:`cap_blend_radii`); stopping is olp's conservative choice. Idempotent."""
+    if not compiled.program.has_flow:
+        return compiled, []
+    by_index: dict[int, Any] = {s.index: s for s in compiled.steps}
+    ends = [
+        i
+        for i in _motions_before_boundaries(compiled.program.instructions)
+        if i in by_index and not by_index[i].instruction.zone.is_fine
+    ]
+    if not ends:
+        return compiled, []
+    stopped = set(ends)
+    steps = tuple(
+        dataclasses.replace(s, instruction=_without_blend(s.instruction))
+        if s.index in stopped
+        else s
+        for s in compiled.steps
+    )
+    program = with_step_instructions(compiled.program, [s.instruction for s in steps])
+    found = [_stop_warning(by_index[i]) for i in ends]
+    return dataclasses.replace(compiled, program=program, steps=steps), found
+
+
+def _without_blend(instruction: Any) -> Any:
+    return dataclasses.replace(instruction, zone=dataclasses.replace(instruction.zone, radius=0.0))
+
+
+def _stop_warning(step: Any) -> Diagnostic:
+    ins = step.instruction
+    return Diagnostic(
+        "warning",
+        "blend_stopped",
+        f"blend radius {ins.zone.radius * 1000:.1f} mm written as 0 (the robot stops here): the "
+        "next motion is beyond a block boundary, known only at run time, so olp cannot keep "
+        "the blends from overlapping (the controller would skip a move); the cycle time per "
+        "path times it as a stop too",
+        ins.span,
+        step.index,
+    )
+
+
+def _motions_before_boundaries(nodes: Sequence[Any]) -> list[int]:
+    """Step indices of the motions whose next motion in the text comes after a block boundary
+    (or that are followed by one and no motion)."""
+    out: list[int] = []
+    previous: int | None = None
+    crossed = False
+    for token in _flow_tokens(nodes, itertools.count()):
+        if token is None:
+            crossed = True
+            continue
+        if previous is not None and crossed:
+            out.append(previous)
+        previous, crossed = token, False
+    if previous is not None and crossed:
+        out.append(previous)
+    return out
+
+
+def _flow_tokens(nodes: Sequence[Any], counter: Iterator[int]) -> Iterator[int | None]:
+    """The program's motions as their step indices, and None at each block boundary, in the
+    order of the text (step indices count the leaves, a toolpath's rows one each)."""
+    for node in nodes:
+        if isinstance(node, ir.BLOCK_TYPES):
+            yield None
+            for body in bodies(node):
+                yield from _flow_tokens(body, counter)
+                yield None
+        elif isinstance(node, ir.LinearPath):
+            for _ in range(len(node)):
+                yield next(counter)
+        else:
+            index = next(counter)
+            if isinstance(node, ir.MOTION_TYPES):
+                yield index
+            elif isinstance(node, ir.Label | ir.Goto | ir.Exit | ir.Return):
+                yield None
+
+
 class UrPost(Post):
     """Universal Robots URScript; see the module docstring."""
 
@@ -268,13 +384,36 @@ class UrPost(Post):
     ACCELERATIONS: ClassVar[frozenset[str]] = frozenset({"linear_acceleration"})
     NUMBERS: ClassVar[Mapping[str, NumberFormat]] = NUMBERS
     FILTERS: ClassVar[Mapping[str, Filter]] = FILTERS
-    TRANSFORMS = (cap_blend_radii,)
+    TRANSFORMS = (stop_at_block_boundaries, cap_blend_radii)
     ARC_ORIENTATIONS = frozenset({ArcOrientation.INTERPOLATE, ArcOrientation.PATH_CONSTANT})
+    WRITES_FLOW = True
+
+    def __init__(self, manifest: Any) -> None:
+        super().__init__(manifest)
+        self.flow: UrWriter | None = None
+        """The flow writer of the file being rendered (made by :meth:`context_values`)."""
+
+    def writer(self, nodes: Sequence[Any]) -> UrWriter:
+        """A :class:`~olp.posts.ur_flow.UrWriter` for a program's statements."""
+        return UrWriter(Symbols(nodes), NAME_RULE, POST_BUILTINS)
+
+    def reserved_names(self, compiled: CompiledProgram) -> Sequence[str]:
+        """The program's variable names (:class:`~olp.posts.flow_text.Symbols`)."""
+        return list(Symbols(compiled.program.instructions).spelling.values())
+
+    def context_values(self, steps: Sequence[PostStep]) -> Mapping[str, Any]:
+        """The flow writer of this file (``vendor.flow_kinds``: the steps it writes)."""
+        self.flow = self.writer([s.instruction for s in steps if s.kind in FLOW_STEP_KINDS])
+        self.flow.prepare(steps)
+        return {"flow_kinds": FLOW_STEP_KINDS}
 
     def check_program(self, compiled: CompiledProgram) -> list[Diagnostic]:
         """``program_too_long`` (warning): more than :data:`MAX_MOTIONS` motions;
-        ``arc_blend`` (error): blends at arcs the controller refuses (module docstring)."""
-        found = arc_blends(compiled)
+        ``arc_blend`` (error): blends at arcs the controller refuses (module docstring);
+        ``flow`` (error): a control-flow statement or declaration URScript cannot hold
+        exactly (:mod:`olp.posts.ur_flow`)."""
+        nodes = compiled.program.instructions
+        found = flow_problems(nodes, self.writer(nodes)) + arc_blends(compiled)
         motions = sum(1 for s in compiled.steps if s.joints is not None)
         if motions <= MAX_MOTIONS:
             return found

@@ -177,9 +177,27 @@ def cap_blends(compiled: CompiledProgram) -> tuple[CompiledProgram, list[Diagnos
         else s
         for s in compiled.steps
     )
-    program = compiled.program.replace_instructions([s.instruction for s in steps])
+    program = with_step_instructions(compiled.program, [s.instruction for s in steps])
     capped = dataclasses.replace(compiled, program=program, steps=steps)
     return capped, [_diagnostic(c, compiled.steps[c.index].instruction) for c in changed.values()]
+
+
+def with_step_instructions(program: Any, instructions: list[Any]) -> Any:
+    """``program`` with its instructions replaced, in order, by ``instructions`` (one per step);
+    the blocks of a program with control flow are kept (a flat list would drop them, and write
+    every branch's body unconditionally)."""
+    if not program.has_flow:
+        return program.replace_instructions(instructions)
+    from olp.ir import LinearPath
+    from olp.ir_flow import map_leaves
+
+    rest = iter(instructions)
+
+    def edit(node: Any) -> list[Any]:
+        count = len(node) if isinstance(node, LinearPath) else 1
+        return [next(rest) for _ in range(count)]
+
+    return program.replace_instructions(map_leaves(program.instructions, edit))
 
 
 def _with_radius(instruction: Any, radius: float) -> Instruction:

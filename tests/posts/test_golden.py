@@ -2,8 +2,9 @@
 
 USERS.md jobs 1-6 on the KUKA cell for the KRL and RAPID posts (RAPID: transpiled), job 5 split
 into parts, the pick program on the ABB cell, and for URScript and LS the milling program (a
-KUKA program transpiled, foreign robot warned) and a native program on their own cells; for LS
-also two KRL programs with control flow (``flow_mixed`` through a copy of the post with
+KUKA program transpiled, foreign robot warned) and a native program on their own cells; KRL
+programs with control flow (tests/posts/flow/) through the RAPID and URScript posts, and for LS
+two KRL programs with control flow (``flow_mixed`` through a copy of the post with
 ``mixed_logic: true``). A change to a golden file needs a stated reason in the commit: after a
 reviewed change, regenerate with ``OLP_UPDATE_GOLDEN=1 python -m pytest
 tests/posts/test_golden.py`` (the test then fails once, so the variable can never pass CI by
@@ -39,6 +40,7 @@ ABB_CELL = "stations/abb_irb120_pick_cell.yaml"
 UR_CELL = "stations/ur5e_screw_cell.yaml"
 FANUC_CELL = "stations/fanuc_m20ia_weld_cell.yaml"
 TRANSPILE = "tests/posts/transpile.src"
+FLOW = "tests/posts/flow"
 
 USERS_JOBS: dict[str, tuple[str, str, dict[str, Any]]] = {
     "job1_weld_polygon": (KUKA_CELL, "examples/weld_polygon.py", {}),
@@ -73,7 +75,19 @@ CASES: dict[tuple[str, str], tuple[str, str, dict[str, Any]]] = {
     ("fanuc", "flow_cycle"): (FANUC_CELL, "tests/posts/fanuc_flow/cycle.src", {}),
     ("fanuc", "flow_mixed"): (FANUC_CELL, "tests/posts/fanuc_flow/mixed.src", {}),
     **{(post, "weld_rounded"): (KUKA_CELL, "examples/weld_rounded.src", {}) for post in ENDINGS},
+    **{
+        (post, job): (KUKA_CELL, f"{FLOW}/{job}.src", {})
+        for post, job in [
+            ("abb", "flow_branches"),
+            ("abb", "flow_loops"),
+            ("ur", "flow_branches"),
+            ("ur", "flow_loops"),
+            ("ur", "flow_exit"),
+        ]
+    },
 }
+"""The flow jobs (issue 15): KRL control flow written as RAPID and URScript (RAPID's EXIT and
+GOTO need labels, which rapidchecker cannot parse: pinned in tests/posts/test_flow_posts.py)."""
 SPLIT = [("kuka", "job5_milling_split"), ("abb", "job5_milling_split")]
 """Job 5 through a copy of the post that allows 3 motions per file."""
 

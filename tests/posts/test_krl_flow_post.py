@@ -1,5 +1,5 @@
-"""The KRL post writes control flow and data (issue 15, step 5); the other posts stop on them
-with an error naming the first one."""
+"""The KRL post writes control flow and data (issue 15, step 5); a post that does not yet stops
+on them with an error naming the first one (RAPID and URScript: tests/posts/test_flow_posts.py)."""
 
 from __future__ import annotations
 
@@ -60,12 +60,26 @@ def test_krl_to_krl_keeps_every_statement(station: object, name: str, tmp_path: 
     assert len(list(again.motions())) == len(list(source.motions()))
 
 
-@pytest.mark.parametrize("post", ["abb", "ur"])
-def test_other_posts_stop_on_control_flow_naming_it(station: object, post: str) -> None:
-    result = build(station, CORPUS / "Program" / "pick_part.src", post)
+@pytest.mark.parametrize("post", ["kuka", "abb", "ur", "fanuc"])
+def test_every_post_writes_control_flow_unless_its_folder_predates_it(
+    station: object, post: str, tmp_path: Path
+) -> None:
+    """Every bundled post writes pick_part.src's IF; a copy of its folder without
+    ``flow: true`` (made before olp wrote control flow) stops, naming the first statement."""
+    import shutil
+
+    from olp.posts import find_post
+
+    source = CORPUS / "Program" / "pick_part.src"
+    assert not [d for d in build(station, source, post).diagnostics if d.kind == "control_flow"]
+    folder = tmp_path / f"old_{post}"
+    shutil.copytree(find_post(post).manifest.folder, folder)
+    manifest = folder / "post.yaml"
+    manifest.write_text(manifest.read_text().replace("flow: true\n", ""))
+    result = build(station, source, str(folder))
     errors = [d for d in result.diagnostics if d.severity == "error"]
     assert [(d.kind, d.span.line if d.span else 0) for d in errors] == [("control_flow", 22)]
-    assert "if at line 22" in errors[0].message and not result.files
+    assert "flow: true" in errors[0].message and not result.files
 
 
 def down(x: float, speed: float, line: int) -> ir.LinearMove:
