@@ -298,6 +298,9 @@ class LineTimeLaw:
     ``q0``, ``q1``: the line's ends (dof,) rad; ``accel``: 1/s² in fractions of the line;
     ``ramp``: the time (s) of each of the acceleration and braking phases; ``total``: the
     duration (s); ``jerk_time`` (s). The cruise speed is ``accel * (ramp - jerk_time)`` (1/s).
+    ``bow`` (dof,) rad, if given: the path is the parabola ``q0 + u (q1 - q0) + u (u - 1) bow``
+    (a move resolved as three samples, as the chain timer's spline through them,
+    :func:`olp.passes.timing.lines.line_paths`), ``u`` its chord-length parameter's fraction.
     """
 
     q0: FloatArray
@@ -306,6 +309,7 @@ class LineTimeLaw:
     ramp: float
     total: float
     jerk_time: float = 0.0
+    bow: FloatArray | None = None
 
     @property
     def duration(self) -> float:
@@ -332,13 +336,19 @@ class LineTimeLaw:
         """Joint position, velocity, acceleration (T, dof) at times ``t`` (T,) s."""
         u, ud, udd = self.fraction_state(t)
         line = self.q1 - self.q0
-        return self.q0 + u[:, None] * line, ud[:, None] * line, udd[:, None] * line
+        if self.bow is None:
+            return self.q0 + u[:, None] * line, ud[:, None] * line, udd[:, None] * line
+        u, ud, udd = u[:, None], ud[:, None], udd[:, None]
+        tangent = line + (2.0 * u - 1.0) * self.bow
+        q = self.q0 + u * line + u * (u - 1.0) * self.bow
+        return q, ud * tangent, udd * tangent + 2.0 * ud**2 * self.bow
 
 
 class LineLaws(Sequence[LineTimeLaw]):
     """Many :class:`LineTimeLaw` as arrays (a toolpath's fine-stopped moves), each law made
     only when asked for: ``q0``, ``q1`` (M, dof) rad; ``accel`` (M,) 1/s², ``ramp``, ``total``
-    and ``jerk_time`` (M,) s, as the fields of :class:`LineTimeLaw`."""
+    and ``jerk_time`` (M,) s, ``bow`` (M, dof) rad (None: all straight; a row of zeros:
+    that one), as the fields of :class:`LineTimeLaw`."""
 
     def __init__(
         self,
@@ -348,9 +358,11 @@ class LineLaws(Sequence[LineTimeLaw]):
         ramp: FloatArray,
         total: FloatArray,
         jerk_time: FloatArray | None = None,
+        bow: FloatArray | None = None,
     ) -> None:
         self.q0, self.q1, self.accel, self.ramp, self.total = q0, q1, accel, ramp, total
         self.jerk_time = np.zeros_like(total) if jerk_time is None else jerk_time
+        self.bow = bow
 
     def __len__(self) -> int:
         return int(self.total.size)
@@ -371,6 +383,7 @@ class LineLaws(Sequence[LineTimeLaw]):
             float(self.ramp[k]),
             float(self.total[k]),
             float(self.jerk_time[k]),
+            None if self.bow is None or not np.any(self.bow[k]) else self.bow[k],
         )
 
 
