@@ -3,9 +3,13 @@
 
 * 2,000 random fine-stopped LINs of 5-10 mm (three samples each) on the KR 6 cell, random
   directions and speeds (20-500 mm/s): the closed form takes those whose bound is within
-  ``curve_tolerance`` (1%; measured: 61% of them, and 89% of the 7.5 mm moves of the
-  1,000-point helix of benchmarks/full_builds.py), and its durations lie within 1% of the
-  solver's (measured: -0.26% .. +0.46%; with a 2% tolerance 85% were taken, up to +1.05%).
+  ``curve_tolerance`` (1%; measured: 82% of them, and 97.5% of the 7.5 mm moves of the
+  1,000-point helix of benchmarks/full_builds.py). No duration is below a lower bound on every
+  law's (each joint alone, rest to rest, under its own limits), most are within 1% of it (the
+  others: the TCP speed binds), and the durations lie
+  within -2% .. +1% of the solver's (measured: -1.64% .. +0.45%; where the closed form is
+  faster, it is the lead joint's own optimum at its jerk limit, which the solver's averaged
+  law stays ~1.5% below).
 * The closed-form law's sampled trajectory runs through the three samples and holds the joint
   velocity, acceleration and jerk limits and the TCP speed.
 """
@@ -21,6 +25,7 @@ from olp import ir
 from olp.compiled import CompiledProgram
 from olp.passes.resolve import resolve
 from olp.passes.timing import TimingOptions, time_program
+from olp.passes.timing.scurve import double_s
 from olp.station.loader import load_station
 from olp.station.model import Station
 from olp.trajectory import LineTimeLaw
@@ -69,13 +74,27 @@ def test_three_sample_moves_are_timed_in_closed_form_as_the_solver_would(
     assert closed.ok and solved.ok
     laws = [s.trajectory.law for s in closed.steps[1:]]  # type: ignore[union-attr]
     taken = np.array([isinstance(law, LineTimeLaw) and law.bow is not None for law in laws])
-    assert taken.mean() >= 0.5
+    assert taken.mean() >= 0.75
     assert not any(isinstance(s.trajectory.law, LineTimeLaw) for s in solved.steps[1:])  # type: ignore[union-attr]
     new = np.array([s.duration for s in closed.steps[1:]])
     old = np.array([s.duration for s in solved.steps[1:]])
     ratio = new[taken] / old[taken] - 1.0
-    assert np.all(np.abs(ratio) <= 1e-2), (ratio.min(), ratio.max())
-    assert closed.cycle_time == pytest.approx(solved.cycle_time, rel=2e-3)
+    assert np.all((ratio >= -2e-2) & (ratio <= 1e-2)), (ratio.min(), ratio.max())
+    # No law is faster than the slowest joint alone under its own limits, nor than the TCP's
+    # straight travel at the programmed speed; where no TCP limit binds, the closed form is
+    # within 1% of the first (mostly at it: then it is the optimum).
+    limits = station.robot.limits
+    at_bound = 0
+    for step, duration in zip(np.array(closed.steps[1:])[taken], new[taken], strict=True):
+        assert step.path is not None
+        moves = np.abs(step.path[-1] - step.path[0])
+        alone = double_s(moves, limits.velocity, limits.acceleration, limits.jerk).duration
+        bound = float(np.max(np.where(moves > 0, alone, 0.0)))
+        assert duration >= bound * (1 - 1e-12)
+        assert duration >= step.path_length / step.instruction.speed.linear  # type: ignore[union-attr]
+        at_bound += duration <= bound * (1 + 1e-2)
+    assert at_bound >= 0.5 * taken.sum()
+    assert closed.cycle_time == pytest.approx(solved.cycle_time, rel=1e-2)  # measured: -0.41%
 
 
 def test_the_parabola_law_runs_through_the_samples_within_the_limits(station: Station) -> None:

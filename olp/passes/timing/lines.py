@@ -3,6 +3,7 @@ moves of a program at once (see the package docstring)."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -11,7 +12,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from olp.geometry import rotation_log
-from olp.passes.timing.scurve import double_s
+from olp.passes.timing.scurve import SCurves, double_s
 from olp.passes.timing.tcp import tcp_poses
 from olp.station.model import JointLimits, Robot
 
@@ -37,7 +38,9 @@ class LineProfiles:
     ``ramp``: the time (s) of each of the acceleration and braking phases; ``jerk_time`` (s):
     of each jerk phase (0 without a jerk limit: a trapezoid); ``duration`` (s); ``excess``: a
     bound on the relative excess of ``duration`` over the time-optimal duration of the move (0
-    where no TCP limit binds: the profile is then exact).
+    where no TCP limit binds: the profile is then exact). ``lead`` (M,): -1 where the profile
+    runs in the fraction of the path parameter, else the joint whose fraction it runs in
+    (:func:`_led`; parabolas only); None: -1 for all.
     """
 
     accel: FloatArray
@@ -45,6 +48,7 @@ class LineProfiles:
     duration: FloatArray
     excess: FloatArray
     jerk_time: FloatArray
+    lead: NDArray[np.int64] | None = None
 
 
 def line_profiles(
@@ -169,27 +173,117 @@ def line_profiles(
             peak = np.minimum(peak, relaxed.peak)
     law = double_s(length, slow, slow_acc, slow_jerk)
     best = relaxed.duration
-    if bow is not None:  # each joint alone, rest to rest, is a bound too
-        alone = double_s(
-            np.abs(line).ravel(),
-            np.broadcast_to(limits.velocity, line.shape).ravel(),
-            np.broadcast_to(limits.acceleration, line.shape).ravel(),
-            np.broadcast_to(limits.jerk if jerk else np.inf, line.shape).ravel(),
-        )
-        each = np.where(line != 0.0, alone.duration.reshape(line.shape), 0.0)
-        best = np.maximum(best, np.max(each, axis=-1))
     feasible = (slow_acc > 0) & (slow_jerk > 0)
-    if bow is not None:  # no orientation bound along a parabola (see above)
-        feasible &= ~(turns & np.any(bow != 0.0, axis=-1))
+    lead = np.full(length.shape, -1, dtype=np.int64)
+    accel, ramp, duration, jerk_time = law.accel / length, law.ramp, law.duration, law.jerk_time
+    if bow is not None:
+        feasible &= ~(turns & np.any(bow != 0.0, axis=-1))  # no orientation bound (above)
+        bowed = np.any(bow != 0.0, axis=-1)  # a straight line keeps its exact law above
+        led = _led(line, bow, limits, jerk, rate_hi * length, linear_speed, lin_acc, turns)
+        led = dataclasses.replace(led, ok=led.ok & bowed)
+        best = np.where(bowed, np.maximum(best, led.bound), best)
+        better = led.ok & (~feasible | (led.law.duration < duration))
+        lead = np.where(better, led.joint, -1)
+        accel = np.where(better, led.law.accel, accel)
+        ramp = np.where(better, led.law.ramp, ramp)
+        duration = np.where(better, led.law.duration, duration)
+        jerk_time = np.where(better, led.law.jerk_time, jerk_time)
+        feasible |= better
     with np.errstate(invalid="ignore"):
-        excess = np.where(feasible, law.duration / best - 1.0, np.inf)
+        excess = np.where(feasible, duration / best - 1.0, np.inf)
     return LineProfiles(
-        accel=law.accel / length,
-        ramp=law.ramp,
-        duration=law.duration,
-        excess=excess,
-        jerk_time=law.jerk_time,
+        accel=accel, ramp=ramp, duration=duration, excess=excess, jerk_time=jerk_time, lead=lead
     )
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class _Led:
+    """Parabolas timed by their lead joint (:func:`_led`): ``bound`` (M,) s, a lower bound on
+    every law's duration; ``joint`` (M,) the lead joint; ``law`` the double S of its fraction
+    (in fractions of the move); ``ok`` (M,) where it is one."""
+
+    bound: FloatArray
+    joint: NDArray[np.int64]
+    law: SCurves
+    ok: NDArray[np.bool_]
+
+
+def _led(
+    line: FloatArray,
+    bow: FloatArray,
+    limits: JointLimits,
+    jerk: bool,
+    tcp_rate: FloatArray,
+    linear_speed: FloatArray,
+    linear_accel: FloatArray,
+    turns: NDArray[np.bool_],
+) -> _Led:
+    """Parabolas (``line``, ``bow`` (M, dof) rad) timed along the fraction ``σ`` of the joint
+    that needs longest alone, rest to rest under its own limits (the lead, ``l``): that 1-D
+    double S is a lower bound on any law's duration (exact where the others do not bind).
+
+    With ``β = bow_l / line_l`` (``|β| < 1``: the lead moves one way) the parabola's parameter
+    is ``u(σ) = 2σ / ((1 - β) + sqrt((1 - β)² + 4βσ))``, ``du/dσ = 1 / (1 + (2u - 1) β)``, and
+    every other joint has ``dq_k/dσ = (line_k + (2u - 1) bow_k) du/dσ`` (extreme at the ends,
+    ``(line_k -+ bow_k) / (1 -+ β)``), ``d²q_k/dσ² = 2 g_k (du/dσ)³`` and
+    ``d³q_k/dσ³ = -12 β g_k (du/dσ)⁵`` with ``g_k = bow_k - β line_k``. With ``R1..R3`` the
+    bounds of those over the move, the law is the double S in ``σ`` with ``σ̇ <= min_k v_k /
+    R1_k`` (and the TCP speed: ``tcp_rate`` (M,) m per unit of ``u``, an upper bound, times
+    ``max du/dσ``), ``|σ̈| <= min_k (a_k - R2_k vp²) / R1_k`` and ``|σ⃛| <= min_k (J_k -
+    3 R2_k vp ap - R3_k vp³) / R1_k``, ``vp`` and ``ap`` the peak speed and acceleration of
+    the law without those terms (the law with them peaks lower). Where the lead's own limits
+    are the lowest of these it is the lead's 1-D optimum: exact. A TCP path or orientation
+    limit: not taken."""
+    shape = line.shape
+    alone = double_s(
+        np.abs(line).ravel(),
+        np.broadcast_to(limits.velocity, shape).ravel(),
+        np.broadcast_to(limits.acceleration, shape).ravel(),
+        np.broadcast_to(limits.jerk if jerk else np.inf, shape).ravel(),
+    )
+    each = np.where(line != 0.0, alone.duration.reshape(shape), 0.0)
+    joint = np.argmax(each, axis=-1)
+    rows = np.arange(shape[0])
+    step = line[rows, joint]
+    none = np.full(shape[0], np.inf)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        beta = bow[rows, joint] / step
+        slope = 1.0 / (1.0 - np.abs(beta))  # max du/dσ
+        ends = np.maximum(
+            np.abs(line - bow) / (1.0 - beta)[:, None], np.abs(line + bow) / (1.0 + beta)[:, None]
+        )
+        g = np.abs(bow - beta[:, None] * line)
+        second = 2.0 * g * (slope**3)[:, None]
+        third = 12.0 * np.abs(beta)[:, None] * g * (slope**5)[:, None]
+        speed = np.minimum(
+            np.min(limits.velocity / ends, axis=-1), linear_speed / (tcp_rate * slope)
+        )
+
+        def caps(vp: FloatArray, ap: FloatArray) -> tuple[FloatArray, FloatArray]:
+            vp, ap = vp[:, None], ap[:, None]
+            accel = np.min((limits.acceleration - second * vp**2) / ends, axis=-1)
+            if not jerk:
+                return accel, none
+            rest = 3.0 * second * vp * np.minimum(ap, accel[:, None]) + third * vp**3
+            return accel, np.min((limits.jerk - rest) / ends, axis=-1)
+
+        first = double_s(np.ones(shape[0]), speed, *caps(np.zeros(shape[0]), none))
+        accel, jerks = caps(first.peak, first.accel)
+        law = double_s(np.ones(shape[0]), speed, accel, jerks)
+    ok = (
+        (np.abs(beta) < _MAX_LEAD_BEND)
+        & (np.abs(step) > 0)
+        & (accel > 0)
+        & (jerks > 0)
+        & ~np.isfinite(linear_accel)
+        & ~turns
+    )
+    return _Led(np.max(each, axis=-1), joint, law, ok)
+
+
+_MAX_LEAD_BEND = 0.5
+"""Largest ``|β|`` (the lead joint's rate changes by ``(1 + β) / (1 - β)`` along the move) for
+which a parabola is timed by its lead."""
 
 
 _RELAXATIONS = 3

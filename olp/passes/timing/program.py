@@ -278,6 +278,7 @@ def time_lines(
         profiles.duration[ok],
         profiles.jerk_time[ok],
         bow[ok] if np.any(bow) else None,
+        None if profiles.lead is None else profiles.lead[ok],
     )
     out.duration[rows] = out.end[rows] = profiles.duration[ok]
     out.start[rows] = 0.0
@@ -333,7 +334,7 @@ def _line_profiles(
     return LineProfiles(
         *(
             np.concatenate([getattr(p, f) for p in parts])
-            for f in ("accel", "ramp", "duration", "excess", "jerk_time")
+            for f in ("accel", "ramp", "duration", "excess", "jerk_time", "lead")
         )
     )
 
