@@ -318,20 +318,16 @@ class ProgramView:
         motion = self.motions[step.index]
         new_tool = _changed_object(last, "tool", step.tool)
         new_frame = _changed_object(last, "frame", step.frame)
-        new_zone = changed(last, "zone", ins.zone)
+        new_zone = _changed_value(last, "zone", ins.zone)
         joint = isinstance(ins, JointMove)
-        new_joint_speed = joint and changed(
-            last, "joint_speed", (ins.speed.joint, ins.speed.joint_acceleration)
+        speed = ins.speed
+        new_joint_speed = joint and _changed_value(
+            last, "joint_speed", (speed.joint, speed.joint_acceleration)
         )
-        new_linear_speed = not joint and changed(
+        new_linear_speed = not joint and _changed_value(
             last,
             "linear_speed",
-            (
-                ins.speed.linear,
-                ins.speed.angular,
-                ins.speed.linear_acceleration,
-                ins.speed.angular_acceleration,
-            ),
+            (speed.linear, speed.angular, speed.linear_acceleration, speed.angular_acceleration),
         )
         point, via = names.points[step.index]
         return PostStep(
@@ -367,6 +363,14 @@ def _changed_object(last: dict[str, Any], key: str, value: Any) -> bool:
     if key in last and last[key] is value:
         return False
     return changed(last, key, value)
+
+
+def _changed_value(last: dict[str, Any], key: str, value: Any) -> bool:
+    """:func:`changed` for a value without arrays or poses (a zone, a tuple of speeds), which
+    compares with ``==`` as :func:`_same` would."""
+    same = key in last and (last[key] is value or last[key] == value)
+    last[key] = value
+    return not same
 
 
 def _written_motion(step: Step) -> bool:
