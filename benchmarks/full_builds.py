@@ -64,8 +64,15 @@ def run_olp(*args: str, code: Path | None = None) -> tuple[float, float, int]:
     env = {**os.environ, "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "CI": "1"}
     if code is not None:
         env["PYTHONPATH"] = str(code)
+    # From the repository's parent: the working folder comes first on the import path, so a
+    # run from the repository would import this code even where ``code`` names another.
     done = subprocess.run(
-        [sys.executable, "-c", CHILD, *args], capture_output=True, text=True, env=env, check=False
+        [sys.executable, "-c", CHILD, *args],
+        capture_output=True,
+        text=True,
+        env=env,
+        check=False,
+        cwd=REPO.parent,
     )
     line = next((x for x in done.stderr.splitlines() if x.startswith("@@ ")), None)
     if line is None:
@@ -139,7 +146,7 @@ def main() -> None:
         results.append((f"{post}_build_vs_naive_ik_loop", wall / reference, "x"))
     if args.reference is not None:
         values = {n: v for n, v, _ in results}
-        for name, value, unit in list(results):
+        for name, value, _unit in list(results):
             if not name.startswith("reference_") and f"reference_{name}" in values:
                 ratio = value / values[f"reference_{name}"]
                 results.append((f"{name}_vs_reference", ratio, "x"))
