@@ -7,8 +7,12 @@ one BLAS/OpenMP thread; its wall time and peak resident memory (Linux's VmHWM) a
 own. Also timed: ``olp --help`` and ``olp posts`` (the fixed cost of starting), and a 1k-point
 build. The reference is the naive approach the issue names: olp's own single-pose inverse
 kinematics called once per point in a Python loop, on the same points, in the same run.
+With ``--reference DIR`` (a checkout of other olp code, e.g. ``git archive main | tar -x -C
+DIR``), every build also runs with that code first on the import path, right before this
+code's (the machine's load drifts less between the two), and the ratios this / reference are
+printed.
 
-    python benchmarks/full_builds.py [POINTS] [--posts kuka,abb,ur,fanuc]
+    python benchmarks/full_builds.py [POINTS] [--posts kuka,abb,ur,fanuc] [--reference DIR]
 
 Last lines: ``name: value unit``.
 """
@@ -54,11 +58,21 @@ def helix(points: int, path: Path) -> None:
     np.savetxt(path, xyz, fmt="%.4f", delimiter=",", header="x,y,z", comments="")
 
 
-def run_olp(*args: str) -> tuple[float, float, int]:
-    """Wall time (s), peak memory (MB) and exit code of ``olp ARGS`` in a fresh interpreter."""
+def run_olp(*args: str, code: Path | None = None) -> tuple[float, float, int]:
+    """Wall time (s), peak memory (MB) and exit code of ``olp ARGS`` in a fresh interpreter
+    (``code``: a folder holding another ``olp`` package, imported instead of this one)."""
     env = {**os.environ, "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "CI": "1"}
+    if code is not None:
+        env["PYTHONPATH"] = str(code)
+    # From the repository's parent: the working folder comes first on the import path, so a
+    # run from the repository would import this code even where ``code`` names another.
     done = subprocess.run(
-        [sys.executable, "-c", CHILD, *args], capture_output=True, text=True, env=env, check=False
+        [sys.executable, "-c", CHILD, *args],
+        capture_output=True,
+        text=True,
+        env=env,
+        check=False,
+        cwd=REPO.parent,
     )
     line = next((x for x in done.stderr.splitlines() if x.startswith("@@ ")), None)
     if line is None:
@@ -87,37 +101,55 @@ def naive_ik_seconds(points: int) -> float:
     return time.perf_counter() - start
 
 
+def _build(folder: Path, post: str, label: str, code: Path | None) -> tuple[float, float]:
+    """Wall time (s) and peak memory (MB) of building ``label``.csv in ``folder``."""
+    wall, peak, exit_code = run_olp(
+        "build", str(CELL), str(folder / f"{label}.csv"), "--frame", "table",
+        "--orientation", ORIENTATION, "--post", post, "-o",
+        str(folder / f"out_{post}_{label}"), "--quiet", code=code,
+    )  # fmt: skip
+    if exit_code != 0:
+        raise SystemExit(f"olp build --post {post} on {label} exited {exit_code}")
+    return wall, peak
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("points", nargs="?", type=int, default=100_000)
     parser.add_argument("--posts", default="kuka,abb,ur,fanuc")
+    parser.add_argument("--reference", type=Path, default=None)
     args = parser.parse_args()
     posts = args.posts.split(",")
     results: list[tuple[str, float, str]] = []
+    codes: list[tuple[str, Path | None]] = [("", None)]
+    if args.reference is not None:
+        codes.insert(0, ("reference_", args.reference.resolve()))
     with tempfile.TemporaryDirectory() as scratch:
         folder = Path(scratch)
         for label, count in (("1k", 1000), ("n", args.points)):
             helix(count, folder / f"{label}.csv")
         for command in (("--help",), ("posts",)):
-            wall, _, _ = run_olp(*command)
-            results.append((f"olp_{command[0].strip('-')}_seconds", wall, "s"))
+            for prefix, code in codes:
+                wall, _, _ = run_olp(*command, code=code)
+                results.append((f"{prefix}olp_{command[0].strip('-')}_seconds", wall, "s"))
         for post in posts:
             for label in ("1k", "n"):
-                wall, peak, code = run_olp(
-                    "build", str(CELL), str(folder / f"{label}.csv"), "--frame", "table",
-                    "--orientation", ORIENTATION, "--post", post, "-o",
-                    str(folder / f"out_{post}_{label}"), "--quiet",
-                )  # fmt: skip
-                if code != 0:
-                    raise SystemExit(f"olp build --post {post} on {label} exited {code}")
-                tag = "1k" if label == "1k" else f"{args.points}"
-                results.append((f"{post}_{tag}_build_seconds", wall, "s"))
-                results.append((f"{post}_{tag}_peak_memory", peak, "MB"))
+                for prefix, code in codes:
+                    wall, peak = _build(folder, post, label, code)
+                    tag = "1k" if label == "1k" else f"{args.points}"
+                    results.append((f"{prefix}{post}_{tag}_build_seconds", wall, "s"))
+                    results.append((f"{prefix}{post}_{tag}_peak_memory", peak, "MB"))
     reference = naive_ik_seconds(args.points)
     results.append((f"naive_ik_loop_{args.points}_seconds", reference, "s"))
     for post in posts:
         wall = next(v for n, v, _ in results if n == f"{post}_{args.points}_build_seconds")
         results.append((f"{post}_build_vs_naive_ik_loop", wall / reference, "x"))
+    if args.reference is not None:
+        values = {n: v for n, v, _ in results}
+        for name, value, _unit in list(results):
+            if not name.startswith("reference_") and f"reference_{name}" in values:
+                ratio = value / values[f"reference_{name}"]
+                results.append((f"{name}_vs_reference", ratio, "x"))
     print(f"points: {args.points}")
     for name, value, unit in results:
         print(f"{name}: {value:.3f} {unit}")

@@ -17,9 +17,10 @@ from __future__ import annotations
 
 import bisect
 import dataclasses
+import gc
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, overload
+from typing import TYPE_CHECKING, Any, overload
 
 import numpy as np
 from numpy.typing import NDArray
@@ -101,6 +102,33 @@ class PathBlock:
         lo = 0 if k == 0 else int(self.ends[k - 1])
         return self.path[lo : int(self.ends[k]) + 1]
 
+    def steps(self) -> list[Step]:
+        """Every row as an ordinary :class:`Step` (:meth:`step` of each, its arrays read once:
+        row values as Python numbers, the shared tool and frame as they are)."""
+        n = len(self.node)
+        joints = [None] * n if self.joints is None else list(self.joints)
+        ends = None if self.ends is None else [0, *self.ends.tolist()]
+        durations = [0.0] * n if self.durations is None else self.durations.tolist()
+        lengths = [0.0] * n if self.lengths is None else self.lengths.tolist()
+        rows = self.trajectories
+        segments = [None] * n if rows is None else rows.segments()
+        move, path, tool, frame = self.node.move, self.path, self.tool, self.frame
+        start = self.start
+        return [
+            Step(
+                index=start + k,
+                instruction=move(k),
+                joints=joints[k],
+                path=None if path is None or ends is None else path[ends[k] : ends[k + 1] + 1],
+                tool=tool,
+                frame=frame,
+                duration=durations[k],
+                path_length=lengths[k],
+                trajectory=segments[k],
+            )
+            for k in range(n)
+        ]
+
     def step(self, k: int) -> Step:
         """Row ``k`` as an ordinary :class:`Step`."""
         trajectory = None if self.trajectories is None else self.trajectories.segment(k)
@@ -131,6 +159,24 @@ class RowTrajectories:
         if self.law[k] < 0:
             return None
         return Segment(self.laws[int(self.law[k])], float(self.start[k]), float(self.end[k]))
+
+    def segments(self) -> list[Segment | None]:
+        """:meth:`segment` of every row, the arrays read once (a law shared by several rows,
+        a blended chain's, is one object)."""
+        from olp.trajectory import Segment
+
+        laws, made = self.laws, dict[int, Any]()
+        out: list[Segment | None] = []
+        for law, start, end in zip(
+            self.law.tolist(), self.start.tolist(), self.end.tolist(), strict=True
+        ):
+            if law < 0:
+                out.append(None)
+                continue
+            if law not in made:
+                made[law] = laws[law]
+            out.append(Segment(made[law], start, end))
+        return out
 
 
 Item = Step | PathBlock
@@ -175,8 +221,7 @@ class StepBlocks(Sequence[Step]):
     def __iter__(self) -> Iterator[Step]:
         for item in self.blocks:
             if isinstance(item, PathBlock):
-                for k in range(len(item)):
-                    yield item.step(k)
+                yield from item.steps()
             else:
                 yield item
 
@@ -255,7 +300,16 @@ class CompiledProgram:
         walks the steps several times, such as a post's templates)."""
         if isinstance(self.steps, tuple):
             return self
-        return dataclasses.replace(self, steps=tuple(self.steps))
+        # A toolpath's rows are many small objects without cycles: the cyclic collector's
+        # passes over them while they are made cost ~40% of making them (100,000 rows).
+        was_enabled = gc.isenabled()
+        gc.disable()
+        try:
+            steps = tuple(self.steps)
+        finally:
+            if was_enabled:
+                gc.enable()
+        return dataclasses.replace(self, steps=steps)
 
     def with_diagnostics(self, found: Iterable[Diagnostic]) -> CompiledProgram:
         """A copy with ``found`` appended to the diagnostics."""

@@ -298,6 +298,11 @@ class LineTimeLaw:
     ``q0``, ``q1``: the line's ends (dof,) rad; ``accel``: 1/s² in fractions of the line;
     ``ramp``: the time (s) of each of the acceleration and braking phases; ``total``: the
     duration (s); ``jerk_time`` (s). The cruise speed is ``accel * (ramp - jerk_time)`` (1/s).
+    ``bow`` (dof,) rad, if given: the path is the parabola ``q0 + u (q1 - q0) + u (u - 1) bow``
+    (a move resolved as three samples, as the chain timer's spline through them,
+    :func:`olp.passes.timing.lines.line_paths`), ``u`` its chord-length parameter's fraction;
+    with ``lead`` >= 0 the double S runs in that joint's fraction ``σ`` of its move instead,
+    ``u = 2σ / ((1 - β) + sqrt((1 - β)² + 4βσ))`` with ``β = bow_l / (q1 - q0)_l``.
     """
 
     q0: FloatArray
@@ -306,6 +311,8 @@ class LineTimeLaw:
     ramp: float
     total: float
     jerk_time: float = 0.0
+    bow: FloatArray | None = None
+    lead: int = -1
 
     @property
     def duration(self) -> float:
@@ -332,13 +339,33 @@ class LineTimeLaw:
         """Joint position, velocity, acceleration (T, dof) at times ``t`` (T,) s."""
         u, ud, udd = self.fraction_state(t)
         line = self.q1 - self.q0
-        return self.q0 + u[:, None] * line, ud[:, None] * line, udd[:, None] * line
+        if self.bow is None:
+            return self.q0 + u[:, None] * line, ud[:, None] * line, udd[:, None] * line
+        if self.lead >= 0:
+            u, ud, udd = self._from_lead(u, ud, udd)
+        u, ud, udd = u[:, None], ud[:, None], udd[:, None]
+        tangent = line + (2.0 * u - 1.0) * self.bow
+        q = self.q0 + u * line + u * (u - 1.0) * self.bow
+        return q, ud * tangent, udd * tangent + 2.0 * ud**2 * self.bow
+
+    def _from_lead(
+        self, sigma: FloatArray, rate: FloatArray, accel: FloatArray
+    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """The parabola's parameter ``u``, its rate and acceleration (T,) from the lead
+        joint's fraction ``σ``, its rate and acceleration (T,)."""
+        assert self.bow is not None
+        beta = float(self.bow[self.lead] / (self.q1 - self.q0)[self.lead])
+        u = 2.0 * sigma / ((1.0 - beta) + np.sqrt((1.0 - beta) ** 2 + 4.0 * beta * sigma))
+        slope = 1.0 / (1.0 + (2.0 * u - 1.0) * beta)  # du/dσ
+        bend = -2.0 * beta * slope**3  # d²u/dσ²
+        return u, slope * rate, bend * rate**2 + slope * accel
 
 
 class LineLaws(Sequence[LineTimeLaw]):
     """Many :class:`LineTimeLaw` as arrays (a toolpath's fine-stopped moves), each law made
     only when asked for: ``q0``, ``q1`` (M, dof) rad; ``accel`` (M,) 1/s², ``ramp``, ``total``
-    and ``jerk_time`` (M,) s, as the fields of :class:`LineTimeLaw`."""
+    and ``jerk_time`` (M,) s, ``bow`` (M, dof) rad (None: all straight; a row of zeros:
+    that one) and ``lead`` (M,) (None: -1 for all), as the fields of :class:`LineTimeLaw`."""
 
     def __init__(
         self,
@@ -348,9 +375,12 @@ class LineLaws(Sequence[LineTimeLaw]):
         ramp: FloatArray,
         total: FloatArray,
         jerk_time: FloatArray | None = None,
+        bow: FloatArray | None = None,
+        lead: IntArray | None = None,
     ) -> None:
         self.q0, self.q1, self.accel, self.ramp, self.total = q0, q1, accel, ramp, total
         self.jerk_time = np.zeros_like(total) if jerk_time is None else jerk_time
+        self.bow, self.lead = bow, lead
 
     def __len__(self) -> int:
         return int(self.total.size)
@@ -371,6 +401,8 @@ class LineLaws(Sequence[LineTimeLaw]):
             float(self.ramp[k]),
             float(self.total[k]),
             float(self.jerk_time[k]),
+            None if self.bow is None or not np.any(self.bow[k]) else self.bow[k],
+            -1 if self.lead is None or self.bow is None else int(self.lead[k]),
         )
 
 

@@ -8,6 +8,7 @@ files of a split program (:meth:`ProgramView.unit_steps`: change flags start afr
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -177,6 +178,7 @@ class _Motion:
     via: FloatArray | None
     vendor: Mapping[str, Any]
     number: int
+    base_pose: FloatArray
 
 
 @dataclass(frozen=True, slots=True)
@@ -210,15 +212,24 @@ class ProgramView:
         flanges = robot.flange_poses(joints)
         values = self._vendor_values(joints)
         ref_inv = inv(self.reference)
-        out = {}
-        for n, (step, flange, vendor) in enumerate(zip(written, flanges, values, strict=True)):
+        # Frames are few (a toolpath's rows share one object): each one's pose once.
+        frame_poses: dict[int, FloatArray] = {}
+        for step in written:
             assert step.frame is not None and step.frame.pose is not None
+            if id(step.frame) not in frame_poses:
+                frame_poses[id(step.frame)] = ref_inv @ step.frame.pose
+        framed = [frame_poses[id(s.frame)] for s in written]
+        poses = np.stack([_pose_in_frame(s, f) for s, f in zip(written, flanges, strict=True)])
+        bases = np.stack(framed) @ poses
+        out = {}
+        for n, (step, vendor) in enumerate(zip(written, values, strict=True)):
             out[step.index] = _Motion(
-                pose=_pose_in_frame(step, flange),
-                frame_pose=ref_inv @ step.frame.pose,
+                pose=poses[n],
+                frame_pose=framed[n],
                 via=_via(step),
                 vendor=vendor,
                 number=n + 1,
+                base_pose=bases[n],
             )
         return out
 
@@ -235,6 +246,8 @@ class ProgramView:
         frames: dict[int, PostFrame] = {}
         tool_keys: dict[tuple[str, bytes], PostTool] = {}
         frame_keys: dict[tuple[str, bytes], PostFrame] = {}
+        # The same tool or frame object again (a toolpath's rows): the same named one.
+        by_object: dict[int, tuple[Any, PostTool | PostFrame]] = {}
         for step in self.compiled.steps:
             motion = self.motions.get(step.index)
             if motion is None:
@@ -242,8 +255,16 @@ class ProgramView:
             via = names.take(via_pattern.format(n=motion.number)) if motion.via is not None else ""
             points[step.index] = (names.take(point_pattern.format(n=motion.number)), via)
             assert step.tool is not None and step.frame is not None
-            tools[step.index] = self._tool(step.tool, tool_keys, names)
-            frames[step.index] = self._frame(step.frame, motion.frame_pose, frame_keys, names)
+            known = by_object.get(id(step.tool))
+            if known is None or known[0] is not step.tool:
+                known = (step.tool, self._tool(step.tool, tool_keys, names))
+                by_object[id(step.tool)] = known
+            tools[step.index] = known[1]  # type: ignore[assignment]
+            seen = by_object.get(id(step.frame))
+            if seen is None or seen[0] is not step.frame:
+                seen = (step.frame, self._frame(step.frame, motion.frame_pose, frame_keys, names))
+                by_object[id(step.frame)] = seen
+            frames[step.index] = seen[1]  # type: ignore[assignment]
         return Allocation(points, tools, frames)
 
     def _tool(self, tool: Tool, seen: dict[tuple[str, bytes], PostTool], names: Names) -> PostTool:
@@ -295,22 +316,18 @@ class ProgramView:
     def _motion_step(self, step: Step, names: Allocation, last: dict[str, Any]) -> PostStep:
         ins: Any = step.instruction
         motion = self.motions[step.index]
-        new_tool = changed(last, "tool", step.tool)
-        new_frame = changed(last, "frame", step.frame)
-        new_zone = changed(last, "zone", ins.zone)
+        new_tool = _changed_object(last, "tool", step.tool)
+        new_frame = _changed_object(last, "frame", step.frame)
+        new_zone = _changed_value(last, "zone", ins.zone)
         joint = isinstance(ins, JointMove)
-        new_joint_speed = joint and changed(
-            last, "joint_speed", (ins.speed.joint, ins.speed.joint_acceleration)
+        speed = ins.speed
+        new_joint_speed = joint and _changed_value(
+            last, "joint_speed", (speed.joint, speed.joint_acceleration)
         )
-        new_linear_speed = not joint and changed(
+        new_linear_speed = not joint and _changed_value(
             last,
             "linear_speed",
-            (
-                ins.speed.linear,
-                ins.speed.angular,
-                ins.speed.linear_acceleration,
-                ins.speed.angular_acceleration,
-            ),
+            (speed.linear, speed.angular, speed.linear_acceleration, speed.angular_acceleration),
         )
         point, via = names.points[step.index]
         return PostStep(
@@ -330,7 +347,7 @@ class ProgramView:
             tool_name=names.tools[step.index].name,
             frame_name=names.frames[step.index].name,
             frame_pose=motion.frame_pose,
-            base_pose=motion.frame_pose @ motion.pose,
+            base_pose=motion.base_pose,
             duration=step.duration,
             vendor=motion.vendor,
             new_tool=new_tool,
@@ -339,6 +356,21 @@ class ProgramView:
             new_joint_speed=new_joint_speed,
             new_linear_speed=new_linear_speed,
         )
+
+
+def _changed_object(last: dict[str, Any], key: str, value: Any) -> bool:
+    """:func:`changed`, without comparing when ``value`` is the object recorded."""
+    if key in last and last[key] is value:
+        return False
+    return changed(last, key, value)
+
+
+def _changed_value(last: dict[str, Any], key: str, value: Any) -> bool:
+    """:func:`changed` for a value without arrays or poses (a zone, a tuple of speeds), which
+    compares with ``==`` as :func:`_same` would."""
+    same = key in last and (last[key] is value or last[key] == value)
+    last[key] = value
+    return not same
 
 
 def _written_motion(step: Step) -> bool:
@@ -375,7 +407,7 @@ class Names:
         self.taken = {r.casefold() for r in reserved}
 
     def take(self, wanted: str) -> str:
-        base = self.rule.legal(wanted)
+        base = wanted if self._legal_as_is(wanted) else self.rule.legal(wanted)
         name, k = base, 2
         limit = self.rule.max_length
         while name.casefold() in self.taken:
@@ -384,6 +416,21 @@ class Names:
             name, k = self.rule.legal(cut + suffix), k + 1
         self.taken.add(name.casefold())
         return name
+
+    def _legal_as_is(self, name: str) -> bool:
+        """Whether ``rule.legal(name)`` is ``name`` itself, without building it (a point name
+        per row of a toolpath): ASCII letters, digits and ``_``, a letter first, upper case
+        where the rule says so, short enough, not reserved."""
+        rule = self.rule
+        return (
+            _PLAIN_NAME.match(name) is not None
+            and (not rule.upper or name == name.upper())
+            and (rule.max_length is None or len(name) <= rule.max_length)
+            and not rule.is_reserved(name)
+        )
+
+
+_PLAIN_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
 
 
 class Modal:

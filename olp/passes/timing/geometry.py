@@ -16,8 +16,6 @@ from olp.station.model import Robot
 if TYPE_CHECKING:
     from scipy.interpolate import PPoly
 
-    pass
-
 
 FloatArray = NDArray[np.float64]
 
@@ -267,7 +265,7 @@ class JointSpline:
     derivatives. ``path(s, order)`` (N, dof); ``dof`` and ``path_interval`` as toppra's
     geometric paths have them (the toppra reference solver takes this path)."""
 
-    pieces: tuple[PPoly, PPoly, PPoly]
+    pieces: tuple[PPoly | Pieces, PPoly | Pieces, PPoly | Pieces]
 
     def __call__(self, s: FloatArray, order: int = 0) -> FloatArray:
         out: FloatArray = self.pieces[order](s)
@@ -287,14 +285,45 @@ def joint_path(geometry: ChainGeometry) -> JointSpline:
     three samples, where it is the parabola, built here (scipy solves that case with a dense
     solver that cost up to 5 ms a call on a busy 2-core machine, ~0.1 ms for other counts)."""
     s, q = geometry.s, geometry.q
-    from scipy.interpolate import CubicSpline  # scipy loads only where a chain is timed
+    if s.size == 3:  # without scipy, whose import costs a short program ~0.5 s
+        parabola = _parabola(s, q)
+        slope = parabola.derivative()
+        return JointSpline((parabola, slope, slope.derivative()))
+    from scipy.interpolate import CubicSpline  # scipy loads only where a chain needs it
 
-    spline = _parabola(s, q) if s.size == 3 else CubicSpline(s, q)
+    spline = CubicSpline(s, q)
     first = spline.derivative()
     return JointSpline((spline, first, first.derivative()))
 
 
-def _parabola(s: FloatArray, q: FloatArray) -> PPoly:
+class Pieces:
+    """Piecewise polynomials as scipy's ``PPoly`` holds them (coefficients ``c`` (k, m, dof),
+    highest power first, breakpoints ``x`` (m + 1,)) and evaluated in its order (powers of
+    ``s - x[i]`` summed from the lowest, the end pieces extended), for the paths that need no
+    spline solve."""
+
+    def __init__(self, c: FloatArray, x: FloatArray) -> None:
+        self.c, self.x = c, x
+
+    def __call__(self, s: FloatArray) -> FloatArray:
+        at = np.asarray(s, dtype=np.float64)
+        i = np.clip(np.searchsorted(self.x, at, side="right") - 1, 0, self.x.size - 2)
+        dx = (at - self.x[i])[..., None]
+        out = np.zeros(at.shape + self.c.shape[2:])
+        power = np.ones_like(dx)
+        order = self.c.shape[0]
+        for kp in range(order):
+            out = out + self.c[order - 1 - kp][i] * power
+            power = power * dx
+        return out
+
+    def derivative(self) -> Pieces:
+        order = self.c.shape[0]
+        factor = np.arange(order - 1, 0, -1, dtype=np.float64)[:, None, None]
+        return Pieces(self.c[:-1] * factor, self.x)
+
+
+def _parabola(s: FloatArray, q: FloatArray) -> Pieces:
     """The parabola through three samples (s (3,), q (3, dof)) as a piecewise cubic."""
     h = np.diff(s)
     slope = np.diff(q, axis=0) / h[:, None]
@@ -303,6 +332,4 @@ def _parabola(s: FloatArray, q: FloatArray) -> PPoly:
     rates = np.stack([start, start + curve * h[0]])
     zeros = np.zeros_like(rates)
     coefficients = np.stack([zeros, np.broadcast_to(0.5 * curve, rates.shape), rates, q[:2]])
-    from scipy.interpolate import PPoly
-
-    return PPoly(coefficients, s)
+    return Pieces(coefficients, s)

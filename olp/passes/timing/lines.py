@@ -3,6 +3,8 @@ moves of a program at once (see the package docstring)."""
 
 from __future__ import annotations
 
+import dataclasses
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -10,9 +12,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from olp.geometry import rotation_log
-from olp.passes.timing.scurve import double_s
+from olp.passes.timing.scurve import SCurves, double_s
 from olp.passes.timing.tcp import tcp_poses
-from olp.station.model import Robot
+from olp.station.model import JointLimits, Robot
 
 FloatArray = NDArray[np.float64]
 
@@ -36,7 +38,9 @@ class LineProfiles:
     ``ramp``: the time (s) of each of the acceleration and braking phases; ``jerk_time`` (s):
     of each jerk phase (0 without a jerk limit: a trapezoid); ``duration`` (s); ``excess``: a
     bound on the relative excess of ``duration`` over the time-optimal duration of the move (0
-    where no TCP limit binds: the profile is then exact).
+    where no TCP limit binds: the profile is then exact). ``lead`` (M,): -1 where the profile
+    runs in the fraction of the path parameter, else the joint whose fraction it runs in
+    (:func:`_led`; parabolas only); None: -1 for all.
     """
 
     accel: FloatArray
@@ -44,6 +48,7 @@ class LineProfiles:
     duration: FloatArray
     excess: FloatArray
     jerk_time: FloatArray
+    lead: NDArray[np.int64] | None = None
 
 
 def line_profiles(
@@ -56,6 +61,8 @@ def line_profiles(
     linear_accel: FloatArray | None = None,
     angular_accel: FloatArray | None = None,
     jerk: bool = True,
+    bow: FloatArray | None = None,
+    span: FloatArray | None = None,
 ) -> LineProfiles:
     """Time-optimal rest-to-rest laws along the straight joint lines ``q0 -> q1`` (M, dof) rad,
     vectorised over the moves, under the joint velocity, acceleration and (``jerk``) jerk
@@ -96,48 +103,222 @@ def line_profiles(
     changes by at most ``(c |e|_1)²`` per rad, likewise (used only where an orientation speed
     is given). Measured on the KR 6 helix: on 0.1 mm moves no TCP limit binds (exact); on
     2 mm moves at 50 mm/s the bound is < 1e-3.
+
+    **Parabolas** (``bow`` (M, dof) rad and ``span`` (M,) rad, :func:`line_paths`): the path
+    ``q(s) = q0 + u line + u (u - 1) bow``, ``u = s / span``, the chain timer's spline through
+    a move's three samples. Its ``q'_j`` is linear in ``s`` (``(line -+ bow) / span`` at the
+    ends) and ``q''_j = 2 bow_j / span²`` constant, so every joint limit is bracketed as on a
+    line, with ``|q'_j|`` over the move: the law holds ``ṡ <= min_j v_j / max|q'_j|``,
+    ``|s̈| <= min_j (a_j - |q''_j| V²) / max|q'_j|`` and ``|s⃛| <= min_j (J_j - 3 |q''_j| V A)
+    / max|q'_j|`` (joint jerk is ``q'_j s⃛ + 3 q''_j ṡ s̈`` here), and the optimum is at least
+    as fast as the double S under ``min_j v_j / min|q'_j|``, ``(a_j + |q''_j| V²) / min|q'_j|``
+    and ``(J_j + 3 |q''_j| V A) / min|q'_j|``. The TCP's derivatives along it are bounded by
+    ``Mk = R k! [t^k] exp(a t + b t² / 2)``, ``a = c max|q'|_1``, ``b = c |q''|_1``
+    (:func:`_derivative_bounds`; ``(c |e|_1)^k R`` on a line). A parabola under an orientation
+    limit is left to the solver (its excess is ``inf``).
     """
     line = q1 - q0
-    length = np.linalg.norm(line, axis=-1)
-    unit = line / length[:, None]
+    length = np.linalg.norm(line, axis=-1) if span is None else span
+    bent = np.zeros_like(line) if bow is None else bow
+    start, end = (line - bent) / length[:, None], (line + bent) / length[:, None]
+    most = np.maximum(np.abs(start), np.abs(end))  # max |q'_j| over the move
+    least = np.where(start * end > 0.0, np.minimum(np.abs(start), np.abs(end)), 0.0)
+    curve = 2.0 * np.abs(bent) / (length**2)[:, None]  # |q''_j|
     none = np.full(length.shape, np.inf)
     lin_acc = none if linear_accel is None else linear_accel
     ang_acc = none if angular_accel is None else angular_accel
-    with np.errstate(divide="ignore"):
-        joint_cap = np.min(robot.limits.velocity / np.abs(unit), axis=-1)
-        accel = np.min(robot.limits.acceleration / np.abs(unit), axis=-1)
-        jerks = np.min(robot.limits.jerk / np.abs(unit), axis=-1) if jerk else none
+    limits = robot.limits
     turns = np.isfinite(angular_speed) | np.isfinite(ang_acc)
-    rates = _line_rates(q0, q1, robot, tools, np.where(turns, 1.0, np.inf))
+    rates = _line_rates(q0, q1, robot, tools, np.where(turns, 1.0, np.inf), bent, length)
     rate_lo, rate_hi, turn_lo, turn_hi, bend, spin = rates
-    with np.errstate(divide="ignore", invalid="ignore"):
-        slow = np.minimum.reduce([joint_cap, linear_speed / rate_hi, angular_speed / turn_hi])
-        fast = np.minimum.reduce([joint_cap, linear_speed / rate_lo, angular_speed / turn_lo])
-        slow_acc = np.minimum.reduce(
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        slow = np.minimum.reduce(
             [
-                accel,
-                _accel_cap(lin_acc, -bend * slow**2, rate_hi),
-                _accel_cap(ang_acc, -spin * slow**2, turn_hi),
+                np.min(limits.velocity / most, axis=-1),
+                linear_speed / rate_hi,
+                angular_speed / turn_hi,
             ]
         )
-        fast_acc = np.minimum.reduce(
+        fast = np.minimum.reduce(
             [
-                accel,
-                _accel_cap(lin_acc, bend * fast**2, rate_lo),
-                _accel_cap(ang_acc, spin * fast**2, turn_lo),
+                np.min(limits.velocity / least, axis=-1),
+                linear_speed / rate_lo,
+                angular_speed / turn_lo,
             ]
         )
-    law = double_s(length, slow, slow_acc, jerks)
-    best = double_s(length, fast, fast_acc, jerks).duration
+        tcp_slow = np.minimum(
+            _accel_cap(lin_acc, -bend * slow**2, rate_hi),
+            _accel_cap(ang_acc, -spin * slow**2, turn_hi),
+        )
+
+        def tcp_fast(speed: FloatArray) -> FloatArray:
+            return np.minimum(
+                _accel_cap(lin_acc, bend * speed**2, rate_lo),
+                _accel_cap(ang_acc, spin * speed**2, turn_lo),
+            )
+
+        # The slowest law: caps for the peak speed and acceleration of the law without the
+        # curvature terms (lowering the caps lowers both: the law with them holds them).
+        first = _joint_caps(limits, most, curve, np.zeros_like(slow), none, -1.0, jerk)
+        law = double_s(length, slow, np.minimum(first[0], tcp_slow), first[1])
+        slow_acc, slow_jerk = _joint_caps(limits, most, curve, law.peak, law.accel, -1.0, jerk)
+        slow_acc = np.minimum(slow_acc, tcp_slow)
+        # The fastest: every law the limits allow peaks below the double S of a relaxation,
+        # so that peak bounds the curvature terms of the next, tighter relaxation.
+        peak = fast
+        for _ in range(_RELAXATIONS if bow is not None else 1):
+            fast_acc, fast_jerk = _joint_caps(limits, least, curve, peak, none, 1.0, jerk)
+            fast_acc = np.minimum(fast_acc, tcp_fast(peak))
+            relaxed = double_s(length, fast, fast_acc, fast_jerk)
+            peak = np.minimum(peak, relaxed.peak)
+    law = double_s(length, slow, slow_acc, slow_jerk)
+    best = relaxed.duration
+    feasible = (slow_acc > 0) & (slow_jerk > 0)
+    lead = np.full(length.shape, -1, dtype=np.int64)
+    accel, ramp, duration, jerk_time = law.accel / length, law.ramp, law.duration, law.jerk_time
+    if bow is not None:
+        feasible &= ~(turns & np.any(bow != 0.0, axis=-1))  # no orientation bound (above)
+        bowed = np.any(bow != 0.0, axis=-1)  # a straight line keeps its exact law above
+        led = _led(line, bow, limits, jerk, rate_hi * length, linear_speed, lin_acc, turns)
+        led = dataclasses.replace(led, ok=led.ok & bowed)
+        best = np.where(bowed, np.maximum(best, led.bound), best)
+        better = led.ok & (~feasible | (led.law.duration < duration))
+        lead = np.where(better, led.joint, -1)
+        accel = np.where(better, led.law.accel, accel)
+        ramp = np.where(better, led.law.ramp, ramp)
+        duration = np.where(better, led.law.duration, duration)
+        jerk_time = np.where(better, led.law.jerk_time, jerk_time)
+        feasible |= better
     with np.errstate(invalid="ignore"):
-        excess = np.where(slow_acc > 0, law.duration / best - 1.0, np.inf)
+        excess = np.where(feasible, duration / best - 1.0, np.inf)
     return LineProfiles(
-        accel=law.accel / length,
-        ramp=law.ramp,
-        duration=law.duration,
-        excess=excess,
-        jerk_time=law.jerk_time,
+        accel=accel, ramp=ramp, duration=duration, excess=excess, jerk_time=jerk_time, lead=lead
     )
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class _Led:
+    """Parabolas timed by their lead joint (:func:`_led`): ``bound`` (M,) s, a lower bound on
+    every law's duration; ``joint`` (M,) the lead joint; ``law`` the double S of its fraction
+    (in fractions of the move); ``ok`` (M,) where it is one."""
+
+    bound: FloatArray
+    joint: NDArray[np.int64]
+    law: SCurves
+    ok: NDArray[np.bool_]
+
+
+def _led(
+    line: FloatArray,
+    bow: FloatArray,
+    limits: JointLimits,
+    jerk: bool,
+    tcp_rate: FloatArray,
+    linear_speed: FloatArray,
+    linear_accel: FloatArray,
+    turns: NDArray[np.bool_],
+) -> _Led:
+    """Parabolas (``line``, ``bow`` (M, dof) rad) timed along the fraction ``σ`` of the joint
+    that needs longest alone, rest to rest under its own limits (the lead, ``l``): that 1-D
+    double S is a lower bound on any law's duration (exact where the others do not bind).
+
+    With ``β = bow_l / line_l`` (``|β| < 1``: the lead moves one way) the parabola's parameter
+    is ``u(σ) = 2σ / ((1 - β) + sqrt((1 - β)² + 4βσ))``, ``du/dσ = 1 / (1 + (2u - 1) β)``, and
+    every other joint has ``dq_k/dσ = (line_k + (2u - 1) bow_k) du/dσ`` (extreme at the ends,
+    ``(line_k -+ bow_k) / (1 -+ β)``), ``d²q_k/dσ² = 2 g_k (du/dσ)³`` and
+    ``d³q_k/dσ³ = -12 β g_k (du/dσ)⁵`` with ``g_k = bow_k - β line_k``. With ``R1..R3`` the
+    bounds of those over the move, the law is the double S in ``σ`` with ``σ̇ <= min_k v_k /
+    R1_k`` (and the TCP speed: ``tcp_rate`` (M,) m per unit of ``u``, an upper bound, times
+    ``max du/dσ``), ``|σ̈| <= min_k (a_k - R2_k vp²) / R1_k`` and ``|σ⃛| <= min_k (J_k -
+    3 R2_k vp ap - R3_k vp³) / R1_k``, ``vp`` and ``ap`` the peak speed and acceleration of
+    the law without those terms (the law with them peaks lower). Where the lead's own limits
+    are the lowest of these it is the lead's 1-D optimum: exact. A TCP path or orientation
+    limit: not taken."""
+    shape = line.shape
+    alone = double_s(
+        np.abs(line).ravel(),
+        np.broadcast_to(limits.velocity, shape).ravel(),
+        np.broadcast_to(limits.acceleration, shape).ravel(),
+        np.broadcast_to(limits.jerk if jerk else np.inf, shape).ravel(),
+    )
+    each = np.where(line != 0.0, alone.duration.reshape(shape), 0.0)
+    joint = np.argmax(each, axis=-1)
+    rows = np.arange(shape[0])
+    step = line[rows, joint]
+    none = np.full(shape[0], np.inf)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        beta = bow[rows, joint] / step
+        slope = 1.0 / (1.0 - np.abs(beta))  # max du/dσ
+        ends = np.maximum(
+            np.abs(line - bow) / (1.0 - beta)[:, None], np.abs(line + bow) / (1.0 + beta)[:, None]
+        )
+        g = np.abs(bow - beta[:, None] * line)
+        second = 2.0 * g * (slope**3)[:, None]
+        third = 12.0 * np.abs(beta)[:, None] * g * (slope**5)[:, None]
+        speed = np.minimum(
+            np.min(limits.velocity / ends, axis=-1), linear_speed / (tcp_rate * slope)
+        )
+
+        def caps(vp: FloatArray, ap: FloatArray) -> tuple[FloatArray, FloatArray]:
+            vp, ap = vp[:, None], ap[:, None]
+            accel = np.min((limits.acceleration - second * vp**2) / ends, axis=-1)
+            if not jerk:
+                return accel, none
+            rest = 3.0 * second * vp * np.minimum(ap, accel[:, None]) + third * vp**3
+            return accel, np.min((limits.jerk - rest) / ends, axis=-1)
+
+        first = double_s(np.ones(shape[0]), speed, *caps(np.zeros(shape[0]), none))
+        accel, jerks = caps(first.peak, first.accel)
+        law = double_s(np.ones(shape[0]), speed, accel, jerks)
+    ok = (
+        (np.abs(beta) < _MAX_LEAD_BEND)
+        & (np.abs(step) > 0)
+        & (accel > 0)
+        & (jerks > 0)
+        & ~np.isfinite(linear_accel)
+        & ~turns
+    )
+    return _Led(np.max(each, axis=-1), joint, law, ok)
+
+
+_MAX_LEAD_BEND = 0.5
+"""Largest ``|β|`` (the lead joint's rate changes by ``(1 + β) / (1 - β)`` along the move) for
+which a parabola is timed by its lead."""
+
+
+_RELAXATIONS = 3
+"""Relaxations of a parabola's fastest law, each bounding the curvature terms by the previous
+one's peak speed."""
+
+
+def _joint_caps(
+    limits: JointLimits,
+    rate: FloatArray,
+    curve: FloatArray,
+    peak: FloatArray,
+    accel: FloatArray,
+    sign: float,
+    jerk: bool,
+) -> tuple[FloatArray, FloatArray]:
+    """Caps (M,) on ``|s̈|`` and ``|s⃛|`` from the joints' acceleration and jerk limits with
+    ``|q'_j|`` at ``rate`` (M, dof), ``|q''_j| = curve`` (M, dof), along a law peaking at
+    ``peak`` (M,) with at most ``accel`` (M,): ``(a_j + sign |q''_j| peak²) / rate_j`` and
+    ``(J_j + sign 3 |q''_j| peak accel) / rate_j`` (``sign`` -1: what holds the limits,
+    +1: what every law within them holds); the jerk cap ``inf`` without ``jerk``."""
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        acc = np.min((limits.acceleration + sign * _times(curve, peak**2)) / rate, axis=-1)
+        if not jerk:
+            return acc, np.full(acc.shape, np.inf)
+        bound = np.minimum(accel, acc)
+        jerks = np.min((limits.jerk + sign * 3.0 * _times(curve, peak * bound)) / rate, axis=-1)
+    return acc, jerks
+
+
+def _times(curve: FloatArray, value: FloatArray) -> FloatArray:
+    """``curve * value[:, None]`` (M, dof), exactly 0 where ``curve`` is 0 (``value`` may be
+    ``inf`` there: a line's caps stay exactly the limits)."""
+    out: FloatArray = np.where(curve > 0.0, curve * value[:, None], 0.0)
+    return out
 
 
 def _accel_cap(limit: FloatArray, slack: FloatArray, rate: FloatArray) -> FloatArray:
@@ -158,19 +339,28 @@ def trapezoid(length: FloatArray, peak: FloatArray, accel: FloatArray) -> tuple[
 
 
 def _line_rates(
-    q0: FloatArray, q1: FloatArray, robot: Robot, tools: FloatArray, angular_speed: FloatArray
+    q0: FloatArray,
+    q1: FloatArray,
+    robot: Robot,
+    tools: FloatArray,
+    angular_speed: FloatArray,
+    bow: FloatArray,
+    length: FloatArray,
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
     """Bounds (M,) on the TCP's linear rate (m/rad) and orientation rate (rad/rad) along the
-    joint lines ``q0 -> q1``: low and high of each, and upper bounds on the magnitude of their
-    derivatives along the line, ``|p''|`` (m/rad²) and ``(c |e|_1)²`` (rad/rad²) (see
-    :func:`line_profiles`)."""
+    joint lines ``q0 -> q1`` (parabolas with ``bow`` (M, dof) rad over ``length`` (M,) rad of
+    path parameter): low and high of each, and upper bounds on the magnitude of their
+    derivatives along the path, ``|p''|`` (m/rad²) and ``(c |e|_1)²`` (rad/rad², lines only)
+    (see :func:`line_profiles`)."""
     line = q1 - q0
-    length = np.linalg.norm(line, axis=-1)
     half = 0.5 * length
     k = 0.5 * half
-    norm1 = _COUPLING_BOUND * np.sum(np.abs(line), axis=-1) / length
-    fractions = np.array([0.0, 0.25, 0.5, 0.75, 1.0])
-    joints = (q0[None] + fractions[:, None, None] * line[None]).reshape(-1, q0.shape[1])
+    widest = np.maximum(np.sum(np.abs(line - bow), axis=-1), np.sum(np.abs(line + bow), axis=-1))
+    norm1 = _COUPLING_BOUND * widest / length
+    norm2 = _COUPLING_BOUND * 2.0 * np.sum(np.abs(bow), axis=-1) / length**2
+    fractions = np.array([0.0, 0.25, 0.5, 0.75, 1.0])[:, None, None]
+    points = q0[None] + fractions * line[None] + fractions * (fractions - 1.0) * bow[None]
+    joints = points.reshape(-1, q0.shape[1])
     poses = tcp_poses(robot, joints, np.concatenate([tools] * 5))
     p = poses[:, :3, 3].reshape(5, -1, 3)
     slope = (p[0] - 8 * p[1] + 8 * p[3] - p[4]) / (12 * k)[:, None]
@@ -179,7 +369,8 @@ def _line_rates(
     rate2 = np.sum(slope**2, axis=-1)
     along = 2.0 * half * np.abs(np.sum(slope * bend, axis=-1))
     across = (half * np.linalg.norm(bend, axis=-1)) ** 2
-    rest = 0.5 * half**2 * np.linalg.norm(twist, axis=-1) + _remainder(half, norm1)
+    m = _derivative_bounds(norm1, norm2)
+    rest = 0.5 * half**2 * np.linalg.norm(twist, axis=-1) + _remainder(half, m)
     rate_lo = np.sqrt(np.maximum(rate2 - along, 0.0)) - rest
     rate_hi = np.sqrt(rate2 + along + across) + rest
     turn = np.zeros_like(length)
@@ -189,11 +380,7 @@ def _line_rates(
         relative = np.swapaxes(rotations[0][limited], -1, -2) @ rotations[4][limited]
         turn[limited] = np.linalg.norm(rotation_log(relative), axis=-1) / length[limited]
     spread = half * norm1**2 * (1.0 + half * norm1)
-    bend_hi = (
-        np.linalg.norm(bend, axis=-1)
-        + half * np.linalg.norm(twist, axis=-1)
-        + half**2 * norm1**4 * _REACH_BOUND_M
-    )
+    bend_hi = np.linalg.norm(bend, axis=-1) + half * np.linalg.norm(twist, axis=-1) + half**2 * m[4]
     return (
         np.maximum(rate_lo, 0.0),
         rate_hi,
@@ -204,14 +391,32 @@ def _line_rates(
     )
 
 
-def _remainder(half: FloatArray, norm1: FloatArray) -> FloatArray:
+def _derivative_bounds(norm1: FloatArray, norm2: FloatArray) -> list[FloatArray]:
+    """``Mj`` (M,) for j = 0..6: bounds on the j-th derivative of the TCP position along a
+    joint path with ``c |q'|_1 <= norm1``, ``c |q''|_1 <= norm2`` and no third derivative:
+    ``R j! [t^j] exp(norm1 t + norm2 t² / 2)``. (Faà di Bruno: the j-th derivative of
+    ``p(q(s))`` sums, over the partitions of j into blocks of one and two, multilinear
+    derivatives of ``p`` in ``q'`` and ``q''``, each at most ``R`` times the product of its
+    arguments' scaled 1-norms; see :func:`line_profiles`.) ``norm1^j R`` on a line."""
+    out = []
+    for j in range(7):
+        total = np.zeros_like(norm1)
+        for pairs in range(j // 2 + 1):
+            ways = math.factorial(j) // (
+                math.factorial(pairs) * 2**pairs * math.factorial(j - 2 * pairs)
+            )
+            total = total + ways * norm1 ** (j - 2 * pairs) * norm2**pairs
+        out.append(total * _REACH_BOUND_M)
+    return out
+
+
+def _remainder(half: FloatArray, m: list[FloatArray]) -> FloatArray:
     """Bound (M,) m/rad on ``|p'(m + t) - (P1 + t P2 + t² P3 / 2)|`` over ``|t| <= h``
     (``half``), ``P1..P3`` the five-point differences of :func:`_line_rates` (step
     ``k = h / 2``): Taylor's ``h³ M4 / 6`` and the differences' errors ``k⁴ M5 / 30`` (P1),
-    ``h k⁴ M6 / 90`` (P2), ``h² k² M5 / 8`` (P3), where ``Mj = norm1^j R`` bounds the j-th
-    derivative of the TCP position along the line."""
+    ``h k⁴ M6 / 90`` (P2), ``h² k² M5 / 8`` (P3), where ``Mj`` (:func:`_derivative_bounds`)
+    bounds the j-th derivative of the TCP position along the path."""
     k = 0.5 * half
-    m = [norm1**j * _REACH_BOUND_M for j in range(7)]
     out: FloatArray = (
         half**3 * m[4] / 6 + k**4 * m[5] / 30 + half * k**4 * m[6] / 90 + half**2 * k**2 * m[5] / 8
     )
@@ -251,3 +456,44 @@ def straight_samples(
 
 _MIN_LINE_RAD = 1e-9
 """Shorter joint paths are left to the chain timer (which times a move without motion as 0)."""
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class LinePaths:
+    """The joint paths of M moves that the closed form can take: ``timed`` (M,) which;
+    ``q0``, ``q1`` (M, dof) rad their ends, ``bow`` (M, dof) rad (0 on a straight line) and
+    ``span`` (M,) rad the length of their path parameter (the parabola of
+    :class:`olp.trajectory.LineTimeLaw`)."""
+
+    timed: NDArray[np.bool_]
+    q0: FloatArray
+    q1: FloatArray
+    bow: FloatArray
+    span: FloatArray
+
+
+def line_paths(q: FloatArray, sizes: NDArray[np.int64], deviation: float) -> LinePaths:
+    """The moves given end to end (joints ``q`` (S, dof) rad, ``sizes`` (M,) samples each)
+    whose joint path the closed form takes: straight ones (:func:`straight_samples`) and those
+    of three samples, whose path in the chain timer is the parabola through them
+    (:func:`olp.passes.timing.geometry.joint_path`) in the joint-space chord length ``s``: with
+    ``u = s / span``, ``q0 + u (q1 - q0) + u (u - 1) bow`` through the middle sample at
+    ``u = |q_m - q0| / span``."""
+    straight = straight_samples(q, sizes, deviation)
+    first = np.cumsum(sizes) - sizes
+    q0, q1 = q[first], q[first + sizes - 1]
+    line = q1 - q0
+    span = np.linalg.norm(line, axis=-1)
+    bow = np.zeros_like(line)
+    three = np.flatnonzero((sizes == 3) & ~straight)
+    middle = q[first[three] + 1]
+    before = np.linalg.norm(middle - q0[three], axis=-1)
+    after = np.linalg.norm(q1[three] - middle, axis=-1)
+    apart = (before > _MIN_LINE_RAD) & (after > _MIN_LINE_RAD)
+    three, middle, before, after = three[apart], middle[apart], before[apart], after[apart]
+    u = (before / (before + after))[:, None]
+    bow[three] = (middle - q0[three] - u * line[three]) / (u * (u - 1.0))
+    span[three] = before + after
+    timed = straight.copy()
+    timed[three] = True
+    return LinePaths(timed, q0, q1, bow, span)

@@ -26,7 +26,7 @@ from olp.ir import is_motion
 from olp.passes.timing import jerk, ptp, ptp_blend, ur
 from olp.passes.timing.chains import PATH_SOLVERS, path_problem, time_law
 from olp.passes.timing.geometry import joined_geometry
-from olp.passes.timing.lines import LineProfiles, line_profiles, straight_samples
+from olp.passes.timing.lines import LineProfiles, line_paths, line_profiles
 from olp.passes.timing.plan import (
     MIN_PATH_SPEED,
     TimingError,
@@ -252,9 +252,11 @@ def time_lines(
     form, all at once; returns which rows were timed (the others: not straight, or an error
     bound above ``line_tolerance``)."""
     q, sizes = gather(table, rows)
-    straight = straight_samples(q, sizes, options.line_deviation_rad)
+    paths = line_paths(q, sizes, options.line_deviation_rad)
+    straight = paths.timed
     rows = rows[straight]
-    q0, q1 = table.q[table.lo[rows]], table.q[table.hi[rows]]
+    q0, q1 = paths.q0[straight], paths.q1[straight]
+    bow, span = paths.bow[straight], paths.span[straight]
     robot = table.compiled.station.robot
     tools = table.tools[table.tool[rows]]
     profiles = _line_profiles(
@@ -269,8 +271,10 @@ def time_lines(
             table.angular_acceleration[rows],
         ),
         options.path_jerk,
+        (bow, span),
     )
-    ok = profiles.excess <= options.line_tolerance
+    bowed = np.any(bow != 0.0, axis=-1)
+    ok = profiles.excess <= np.where(bowed, options.curve_tolerance, options.line_tolerance)
     rows = rows[ok]
     out.lines = LineLaws(
         q0[ok],
@@ -279,6 +283,8 @@ def time_lines(
         profiles.ramp[ok],
         profiles.duration[ok],
         profiles.jerk_time[ok],
+        bow[ok] if np.any(bow) else None,
+        None if profiles.lead is None else profiles.lead[ok],
     )
     out.duration[rows] = out.end[rows] = profiles.duration[ok]
     out.start[rows] = 0.0
@@ -304,11 +310,14 @@ def _line_profiles(
     tools: FloatArray,
     limits: tuple[FloatArray, FloatArray, FloatArray, FloatArray],
     jerk: bool,
+    shapes: tuple[FloatArray, FloatArray],
 ) -> LineProfiles:
     """:func:`line_profiles` in batches of :data:`LINE_ROWS` moves; ``limits``: the TCP's
-    linear and angular speeds and accelerations (M,) each."""
+    linear and angular speeds and accelerations (M,) each; ``shapes``: the paths' bows
+    (M, dof) and spans (M,) (:func:`~olp.passes.timing.lines.line_paths`)."""
 
     linear, angular, linear_accel, angular_accel = limits
+    bow, span = shapes
 
     def batch(part: slice) -> LineProfiles:
         return line_profiles(
@@ -321,6 +330,8 @@ def _line_profiles(
             linear_accel[part],
             angular_accel[part],
             jerk=jerk,
+            bow=bow[part],
+            span=span[part],
         )
 
     parts = [batch(slice(lo, lo + LINE_ROWS)) for lo in range(0, len(q0), LINE_ROWS)]
@@ -329,7 +340,7 @@ def _line_profiles(
     return LineProfiles(
         *(
             np.concatenate([getattr(p, f) for p in parts])
-            for f in ("accel", "ramp", "duration", "excess", "jerk_time")
+            for f in ("accel", "ramp", "duration", "excess", "jerk_time", "lead")
         )
     )
 
