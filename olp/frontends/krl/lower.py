@@ -28,6 +28,8 @@ from olp.frontends.krl.ast import (
     ForLoop,
     IgnoredLine,
     Index,
+    InterruptCtl,
+    InterruptDecl,
     Module,
     MotionStmt,
     Other,
@@ -35,12 +37,14 @@ from olp.frontends.krl.ast import (
     SignalDecl,
     SourceSet,
     Stmt,
+    Trigger,
     Unary,
     Var,
     WaitFor,
     WaitSec,
 )
 from olp.frontends.krl.data import OTHER_REASONS, KrlData
+from olp.frontends.krl.events import Events
 from olp.frontends.krl.flow import assigned_names, is_straight, jump_targets, statements, to_expr
 from olp.frontends.krl.motion import Motions
 from olp.frontends.krl.state import (
@@ -123,7 +127,7 @@ class RoutineJumps:
         return cls(labels, jump_targets(body), assigned_names(body))
 
 
-class _Lowering(Motions):
+class _Lowering(Motions, Events):
     """Walks statements (inlining calls, unrolling constant FOR loops over straight-line code,
     lowering blocks to :mod:`olp.ir_flow` blocks), appending IR.
 
@@ -157,6 +161,9 @@ class _Lowering(Motions):
             SignalDecl: self._signal,
             ForLoop: self._for,
             Block: self._block,
+            InterruptDecl: self._interrupt_decl,
+            InterruptCtl: self._interrupt_ctl,
+            Trigger: self._trigger,
             Other: self._other,
         }
 
