@@ -25,7 +25,8 @@ Besides, it counts statements of the ``.src`` olp read but did not put in the ou
 reported only at ``info`` level (``silent_drops``: "nothing dropped silently" wants 0), and, for
 the files that build, where each statement of the ``.src`` went: ``kept`` (a node of the
 program's IR carries its line, so the KRL post writes it), ``absorbed`` into the motions' speeds,
-zones, tools and bases (inline-form data, BAS, ``$VEL``/``$TOOL``/``$BASE``/``$APO``), an
+zones, tools and bases (inline-form data, BAS, ``$VEL``/``$ACC``/``$TOOL``/``$BASE``/``$APO``/
+``$ORI_TYPE``), an
 ``inlined`` call of the module's own DEF, ``warned`` (reported as not in the output), or
 ``unaccounted`` (the figure that must be 0: listed).
 
@@ -77,8 +78,11 @@ class Tally:
 
 
 def construct_of(message: str, source_line: str | None) -> str:
-    """The construct an :class:`~olp.errors.OlpError` stopped on: the block a statement sits in,
-    else the first keyword of the offending line, else the message's first words."""
+    """The construct an :class:`~olp.errors.OlpError` stopped on: ``undeclared name`` (a name
+    that a data list or the controller's $config.dat would declare), else the block a statement
+    sits in, else the first keyword of the offending line, else the message's first words."""
+    if "is not declared" in message:  # a data list or the controller's $config.dat is missing
+        return "undeclared name"
     inside = _INSIDE.search(message)
     if inside:
         return inside.group(1).upper()
@@ -96,8 +100,8 @@ _STRUCTURE = re.compile(
     r"DEFAULT|UNTIL)\b"
 )
 _ABSORBED = re.compile(
-    r"(?i)(BAS\s*\(|(PDAT_ACT|LDAT_ACT|FDAT_ACT)\s*=|\$(VEL|VEL_AXIS|ACC_AXIS|APO|TOOL|BASE|H_POS|"
-    r"IPO_MODE)\b)"
+    r"(?i)(BAS\s*\(|(PDAT_ACT|LDAT_ACT|FDAT_ACT)\s*=|\$(VEL|VEL_AXIS|ACC|ACC_AXIS|APO|TOOL|BASE|"
+    r"H_POS|IPO_MODE|ORI_TYPE|CIRC_TYPE)\b)"
 )
 _ROUTINE = re.compile(r"(?i)(GLOBAL\s+)?(DEF|DEFFCT)\b")
 _CALL = re.compile(r"\s*([A-Za-z_][A-Za-z0-9_]*)\s*\(")

@@ -142,3 +142,20 @@ def test_a_copied_post_may_leave_foreign_lines_out_with_a_warning(
     (dropped,) = [d for d in result.diagnostics if d.kind == "verbatim_dropped"]
     assert dropped.severity == "warning" and "'$ADVANCE = 3' (line 12)" in dropped.message
     assert "ADVANCE" not in "".join(result.files.values())
+
+
+def test_an_output_olp_cannot_number_or_value_is_kept_as_written(tmp_path: Path) -> None:
+    """``$OUT[nOut] = bState`` (a PLC handshake with numbers from variables) is a statement of
+    the program: kept for the KRL post, never dropped; a known index and value still make a
+    SetOutput."""
+    path = tmp_path / "io.src"
+    path.write_text(
+        "DEF io( )\nDECL INT nOut\nDECL BOOL bState\nnOut = $IN[7]\nbState = $IN[8]\n"
+        "$OUT[nOut] = TRUE\n$OUT[5] = bState\n$OUT[5] = TRUE\nEND\n"
+    )
+    program = load_krl(path).program
+    kept = [(n.span.line, n.text) for n in program if isinstance(n, ir.Verbatim)]
+    assert kept == [(6, "$OUT[nOut] = TRUE"), (7, "$OUT[5] = bState")]
+    assert [n for n in program if isinstance(n, ir.SetOutput)] == [
+        ir.SetOutput(index=5, value=True, span=ir.SourceSpan(str(path), 8, 1, 8, 15))
+    ]

@@ -513,13 +513,21 @@ class Core:
         self._set_axes_percent(name, dict.fromkeys(range(1, len(AXES) + 1), percent))
 
     def _set_output(self, key: str, value: Expr, stmt: Stmt) -> None:
+        """``$OUT[n] = value``: a :class:`~olp.ir.SetOutput` when ``n`` and the value are known
+        (``$OUT[PGNO_REQ] = FALSE``, the index a variable of $config.dat); otherwise kept as
+        written (``$OUT[nOut] = bState``): the KUKA post writes it back, others stop on it."""
         assert isinstance(stmt, Assign)
-        self._output(self._single_index(stmt.target, "$OUT"), value, stmt)
+        try:
+            index = self._single_index(stmt.target, "$OUT")
+        except ParseError as exc:
+            self._keep(stmt, f"an output olp cannot number: {exc.message}")
+            return
+        self._output(index, value, stmt)
 
     def _output(self, index: int, value: Expr, stmt: Assign) -> None:
         constant = self._value(value)
         if not isinstance(constant, Bool):
-            self._ignore(stmt, "only constant TRUE/FALSE outputs are lowered")
+            self._keep(stmt, "an output set to a value olp does not know (not TRUE or FALSE)")
             return
         self.out.append(ir.SetOutput(index=index, value=constant.value, span=stmt.span))
 
