@@ -159,3 +159,35 @@ def test_an_output_olp_cannot_number_or_value_is_kept_as_written(tmp_path: Path)
     assert [n for n in program if isinstance(n, ir.SetOutput)] == [
         ir.SetOutput(index=5, value=True, span=ir.SourceSpan(str(path), 8, 1, 8, 15))
     ]
+
+
+HERE_PROGRAM = (
+    "DEF here( )\nDECL E6POS pAct\npAct = $POS_ACT\n{between}"
+    "SPTP pAct WITH $VEL_AXIS[1]=10, $VEL_AXIS[2]=10\nPTP XHOME\nEND\n"
+)
+
+
+def test_a_motion_to_a_variable_given_pos_act_is_kept_as_no_motion(tmp_path: Path) -> None:
+    """``pAct = $POS_ACT`` then ``SPTP pAct WITH ...``: the restart "to itself" of real cells.
+    With no motion in between it moves to where the robot stands: kept, nothing to check."""
+    path = tmp_path / "here.src"
+    path.write_text(HERE_PROGRAM.format(between=""))
+    program = load_krl(path, CORPUS / "System" / "$config.dat").program
+    kept = [(n.span.line, n.reason) for n in program if isinstance(n, ir.Verbatim)]
+    assert kept == [(4, "moves to where the robot already is (pAct = $POS_ACT): no motion")]
+    assert [n.span.line for n in program.motions()] == [5]
+
+
+@pytest.mark.parametrize(
+    "between",
+    [
+        "PTP XHOME\n",  # the robot moved: pAct is where it was, olp does not know where
+        "IF $IN[3] THEN\nPTP XHOME\nENDIF\n",
+        "GO_SOMEWHERE()\n",  # another module's routine may move it
+    ],
+)
+def test_a_held_pos_act_is_stale_after_anything_that_may_move(tmp_path: Path, between: str) -> None:
+    path = tmp_path / "here.src"
+    path.write_text(HERE_PROGRAM.format(between=between))
+    with pytest.raises(olp.errors.ParseError, match="pAct"):
+        load_krl(path, CORPUS / "System" / "$config.dat")

@@ -126,6 +126,7 @@ class Motions(InlineForms):
 
     # ---- motions
     def _motion(self, stmt: MotionStmt) -> None:
+        self.motion_count += 1
         base = _BASE_MOTION.get(stmt.keyword)
         if base is None:
             raise self._error(

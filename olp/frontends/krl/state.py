@@ -294,6 +294,15 @@ def data_file_name(data: KrlData) -> str:
 # The core of a lowering
 
 
+HERE = frozenset({"$POS_ACT", "$AXIS_ACT", "$POS_ACT_MES", "$AXIS_ACT_MES"})
+"""Targets that are where the robot stands when the motion starts."""
+
+
+def is_here(expr: object) -> bool:
+    """Whether ``expr`` is one of :data:`HERE`."""
+    return isinstance(expr, Var) and not expr.selectors and expr.name.upper() in HERE
+
+
 class Core:
     """State, variables, reports, values and system-variable assignments of one lowering."""
 
@@ -315,6 +324,8 @@ class Core:
         self.exiting: int | None = None  # line of an EXIT leaving the current loop
         self._after_with: int | None = None  # line of the last motion whose WITH set anything
         self._reported: set[tuple[Any, ...]] = set()
+        self.motion_count = 0  # motions lowered so far (by this lowering)
+        self.here_vars: dict[str, tuple[str, int]] = {}  # name -> ($POS_ACT..., motion_count)
         self._setters: dict[str, Callable[[str, Expr, Stmt], None]] = {
             "$VEL.CP": self._set_vel_cp,
             "$ACC.CP": self._set_acc_cp,
@@ -425,6 +436,12 @@ class Core:
         elif self._is_signal(stmt.target):
             self._signal_output(stmt)
         else:
+            name = stmt.target.name.upper()
+            if is_here(stmt.value) and not stmt.target.selectors:
+                assert isinstance(stmt.value, Var)
+                self.here_vars[name] = (stmt.value.name.upper(), self.motion_count)
+            else:
+                self.here_vars.pop(name, None)
             self.data.assign(stmt)  # what olp knows of the value afterwards
             if stmt.target.name.upper() not in INLINE_FORM_DATA:
                 self.out.append(self._assignment(stmt))
