@@ -333,8 +333,18 @@ class KukaPost(Post):
     NAME_RULE = NAME_RULE
     IO_RANGE = (1, 4096)
     CALL_ARGUMENTS = ArgumentRule(
-        one_of(NUMBER, double_quoted(), IDENTIFIER, "#" + IDENTIFIER, r"\$" + IDENTIFIER),
-        'numbers, "strings", names, #ENUM values, $ variables',
+        one_of(
+            NUMBER,
+            double_quoted(),
+            IDENTIFIER,
+            "#" + IDENTIFIER,
+            r"\$" + IDENTIFIER,
+            # a whole array or an element (P00(#CHK_HOME, #PGNO_GET, DMY[], 0) in every cell.src;
+            # PULSE($OUT[PGNO_REQ], TRUE, 0.2)): names, numbers and commas only inside
+            r"\$?" + IDENTIFIER + r"\[[A-Za-z0-9_$,.+\- ]*\]",
+        ),
+        'numbers, "strings", names, #ENUM values, $ variables, array names and elements '
+        "(NAME[], NAME[1,k])",
     )
     ACCELERATIONS: ClassVar[frozenset[str]] = frozenset(
         {"linear_acceleration", "angular_acceleration"}

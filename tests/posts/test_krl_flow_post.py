@@ -170,3 +170,25 @@ def test_a_post_writing_flow_but_not_events_stops_on_their_line(station: object)
     errors = [d for d in kuka.check(compiled) if d.severity == "error"]
     assert [(d.kind, d.span.line if d.span else 0) for d in errors] == [("unsupported", 6)]
     assert "trigger" in errors[0].message
+
+
+@pytest.mark.parametrize(
+    ("args", "ok"),
+    [
+        (("#CHK_HOME", "#PGNO_GET", "DMY[]", "0"), True),  # the controller's own cell.src
+        (("$OUT[PGNO_REQ]", "TRUE", "0.2"), True),
+        (("nPos[1,k]",), True),
+        (("DMY[];LIN {X 0}",), False),
+        (("DMY[1]) ; x",), False),
+        (('DMY["a"]',), False),
+    ],
+)
+def test_the_krl_post_writes_array_arguments_and_nothing_else(
+    station: object, args: tuple[str, ...], ok: bool
+) -> None:
+    call = ir.Call(name="P00", args=args, span=ir.SourceSpan("t.src", 3, 1))
+    result = build(station, ir.Program(name="p", instructions=(call,)))
+    errors = [d.kind for d in result.diagnostics if d.severity == "error"]
+    assert errors == ([] if ok else ["call_argument"])
+    if ok:
+        assert f"P00({', '.join(args)})" in result.files["p.src"]
