@@ -191,3 +191,19 @@ def test_a_held_pos_act_is_stale_after_anything_that_may_move(tmp_path: Path, be
     path.write_text(HERE_PROGRAM.format(between=between))
     with pytest.raises(olp.errors.ParseError, match="pAct"):
         load_krl(path, CORPUS / "System" / "$config.dat")
+
+
+@pytest.mark.parametrize("again", ["$TOOL = $NULLFRAME", "$TOOL = TOOL_DATA[1]"])
+def test_a_tool_set_again_after_a_branch_is_known_even_if_one_path_had_it(
+    tmp_path: Path, again: str
+) -> None:
+    """The inline forms set the tool before every motion; after an IF whose paths leave
+    different tools, setting it again settles it, also to the tool one of the paths had (a
+    real palletizing program stopped here: its next fold set Tool[0] again)."""
+    path = tmp_path / "tools.src"
+    path.write_text(
+        "DEF tools( )\n$TOOL = $NULLFRAME\nIF $IN[1] THEN\n$TOOL = TOOL_DATA[1]\nENDIF\n"
+        f"{again}\nPTP XHOME\nEND\n"
+    )
+    program = load_krl(path, CORPUS / "System" / "$config.dat").program
+    assert [m.span.line for m in program.motions()] == [7]

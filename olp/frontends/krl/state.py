@@ -606,10 +606,19 @@ class Core:
     def _change_frame(self, frame: ir.Frame, stmt: Stmt | Assign) -> None:
         if frame != self.state.frame:
             self._reset_start(dataclasses.replace(self.state, frame=frame), "$BASE", stmt.span)
+        self._settled("frame")
 
     def _change_tool(self, tool: ir.Tool, stmt: Stmt | Assign) -> None:
         if tool != self.state.tool:
             self._reset_start(dataclasses.replace(self.state, tool=tool), "$TOOL", stmt.span)
+        self._settled("tool")
+
+    def _settled(self, name: str) -> None:
+        """A setting the program has just set is known, whatever the paths before it set (the
+        value may equal the one the state holds after a join: then nothing else changes)."""
+        ambiguous: dict[str, str] | None = getattr(self, "ambiguous", None)
+        if ambiguous:
+            ambiguous.pop(name, None)
 
     def _reset_start(self, state: State, name: str, span: ir.SourceSpan) -> None:
         self.state = state
