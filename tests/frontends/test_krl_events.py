@@ -149,3 +149,13 @@ def test_a_trigger_makes_the_variable_it_sets_unknown(tmp_path: Path) -> None:
 def test_event_nodes_refuse_values_they_cannot_hold(make: object, message: str) -> None:
     with pytest.raises(ir.FlowError, match=message):
         make()  # type: ignore[operator]
+
+
+def test_a_handler_routine_of_the_module_is_named_as_missing_from_the_output() -> None:
+    """The handler is not called where the interrupt is declared, so it is not inlined; the
+    warning says the written program's interrupt calls a routine it does not hold."""
+    result = load_krl(CORPUS / "Program" / "interrupt_watch.src", CONFIG)
+    (line,) = [i for i in result.ignored if "CURTAIN_STOP" in i.reason]
+    assert line.span.line == 24
+    assert "runs from the interrupt at line 11" in line.reason
+    assert "does not hold" in line.reason

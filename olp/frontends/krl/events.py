@@ -62,7 +62,7 @@ class Events(Core):
         decl = ir.InterruptDecl(
             priority=priority,
             condition=self._expr(stmt.condition),
-            handler=self._handler(stmt.action),
+            handler=self._handler(stmt.action, "interrupt"),
             exported=stmt.exported,
             span=stmt.span,
         )
@@ -101,7 +101,7 @@ class Events(Core):
     def _path_trigger(self, stmt: Trigger) -> ir.PathTrigger | None:
         delay = self._number(stmt.delay, "a TRIGGER's DELAY (ms)") * MS
         if isinstance(stmt.action, CallStmt):
-            action: ir.Assign | ir.FunctionCall = self._handler(stmt.action)
+            action: ir.Assign | ir.FunctionCall = self._handler(stmt.action, "TRIGGER")
             priority = None
             if stmt.priority is not None:
                 priority = int(self._number(stmt.priority, "a TRIGGER's PRIO"))
@@ -127,7 +127,8 @@ class Events(Core):
         at = "start" if distance == 0.0 else "end"
         return ir.PathTrigger(action=action, at=at, delay=delay, priority=priority, span=stmt.span)
 
-    def _handler(self, call: CallStmt) -> ir.FunctionCall:
+    def _handler(self, call: CallStmt, what: str) -> ir.FunctionCall:
+        self.ctx.handlers.setdefault(call.name.upper(), f"{what} at line {call.span.line}")
         args = tuple(None if a is None else self._expr(a) for a in call.args)
         return ir.FunctionCall(name=call.name, args=args, span=call.span)
 

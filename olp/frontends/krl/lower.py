@@ -750,6 +750,12 @@ def lower_module(
         if other.name.upper() not in ctx.called:
             what = "is never called" if other.kind == "DEF" else "is a function (not lowered)"
             reason = f"{other.kind} {other.name} {what}"
+            runs_as = ctx.handlers.get(other.name.upper())
+            if runs_as is not None:
+                reason = (
+                    f"DEF {other.name} runs from the {runs_as}; olp does not write routines, so "
+                    "the written program calls a routine it does not hold"
+                )
             lowering.ignored.append(IgnoredLine(other.span, sources.snippet(other.span), reason))
     ignored = sorted(lowering.ignored, key=lambda i: (i.span.line, i.span.column))
     for data_list in (dat, config):

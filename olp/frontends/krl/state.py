@@ -238,6 +238,7 @@ class Context:
         self.sources = sources
         self.routines = routines
         self.called: set[str] = set()
+        self.handlers: dict[str, str] = {}  # routine -> "the interrupt at line 12" (never inlined)
         self.main = next(iter(routines), "")
         self.budget = self.remaining = budget
         self.config = config
@@ -534,12 +535,14 @@ class Core:
         (``$OUT[PGNO_REQ] = FALSE``, the index a variable of $config.dat); otherwise kept as
         written (``$OUT[nOut] = bState``): the KUKA post writes it back, others stop on it."""
         assert isinstance(stmt, Assign)
-        try:
-            index = self._single_index(stmt.target, "$OUT")
-        except ParseError as exc:
-            self._keep(stmt, f"an output olp cannot number: {exc.message}")
-            return
-        self._output(index, value, stmt)
+        selector = stmt.target.selectors[0]
+        if isinstance(selector, Index) and len(selector.args) == 1 and selector.args[0] is not None:
+            number = self._value(selector.args[0])
+            if as_number(number) is None:  # a constant but wrong index stays an error below
+                why = number.reason if isinstance(number, Unknown) else "not a number"
+                self._keep(stmt, f"an output olp cannot number ({why})")
+                return
+        self._output(self._single_index(stmt.target, "$OUT"), value, stmt)
 
     def _output(self, index: int, value: Expr, stmt: Assign) -> None:
         constant = self._value(value)
