@@ -28,7 +28,9 @@ program's IR carries its line, so the KRL post writes it), ``absorbed`` into the
 zones, tools and bases (inline-form data, BAS, ``$VEL``/``$ACC``/``$TOOL``/``$BASE``/``$APO``/
 ``$ORI_TYPE``), an
 ``inlined`` call of the module's own DEF, ``warned`` (reported as not in the output), or
-``unaccounted`` (the figure that must be 0: listed).
+``unaccounted`` (the figure that must be 0: listed). With the KUKA post it also reads the
+written ``.src`` again and compares its statements with the source's, in order
+(``krl_round_trip_differs``: "KRL -> KRL keeps every statement" wants 0).
 
 The last lines are ``name: value unit``.
 """
@@ -75,6 +77,7 @@ class Tally:
     inlined: int = 0
     warned: int = 0
     unaccounted: list[str] = field(default_factory=list)
+    round_trip_differs: list[str] = field(default_factory=list)
 
 
 def construct_of(message: str, source_line: str | None) -> str:
@@ -206,7 +209,41 @@ def _one(olp, path, station, options, post, tally, olp_error) -> str:  # type: i
         return f"program: {errors[0].kind}"
     text = path.read_text(encoding="latin-1")
     account(text, src, result, tally)
+    if post == "kuka" and not round_trips(result, options):
+        tally.round_trip_differs.append(path.name)
+        return "build: KRL -> KRL differs"
     return "build"
+
+
+def shape(program: object) -> list[str]:
+    """The statements and blocks of a program in order, declarations apart (KRL wants them
+    first): motions and other statements by kind, kept lines by their text."""
+    from olp.ir_flow import leaves_and_blocks
+
+    out = []
+    for node in leaves_and_blocks(program.instructions):  # type: ignore[attr-defined]
+        if node.kind == "verbatim":
+            out.append(node.text.upper().replace(" ", ""))
+        elif node.kind != "declare":
+            out.append(node.kind)
+    return out
+
+
+def round_trips(result: object, options: object) -> bool:
+    """KRL -> KRL keeps every statement: the written .src, read again, lowers to the same
+    statements in the same order as the source did."""
+    import tempfile
+
+    from olp.frontends.krl import load_krl
+
+    files = result.files  # type: ignore[attr-defined]
+    with tempfile.TemporaryDirectory() as scratch:
+        for name, text in files.items():
+            (Path(scratch) / name).write_text(text, encoding="latin-1")
+        (written,) = [n for n in files if n.lower().endswith(".src")]
+        config = options.config_dat  # type: ignore[attr-defined]
+        again = load_krl(Path(scratch) / written, config).program
+    return shape(again) == shape(result.compiled.program)  # type: ignore[attr-defined]
 
 
 def main() -> None:
@@ -244,6 +281,9 @@ def main() -> None:
     print(f"statements_inlined_calls: {tally.inlined} statements")
     print(f"statements_warned: {tally.warned} statements")
     print(f"statements_unaccounted: {len(tally.unaccounted)} statements")
+    for name in tally.round_trip_differs:
+        print(f"  KRL -> KRL differs {name}")
+    print(f"krl_round_trip_differs: {len(tally.round_trip_differs)} files")
     print(f"seconds: {seconds:.2f} s")
 
 
