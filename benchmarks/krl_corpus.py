@@ -56,7 +56,9 @@ _KEYWORD_TEXT = (
     "CONST FRAME E6AXIS E6POS POS AXIS INT REAL BOOL CHAR"
 )
 _KEYWORDS = frozenset(_KEYWORD_TEXT.split())
-POST_KINDS = frozenset({"control_flow", "verbatim", "unsupported"})
+POST_KINDS = frozenset(
+    {"control_flow", "verbatim", "unsupported", "call_argument", "call_name", "flow"}
+)
 """Errors of a post that cannot write what the program says: not the program's fault."""
 _INSIDE = re.compile(r"inside the (\w+) at line")
 _WORD = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]*")
