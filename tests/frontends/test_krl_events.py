@@ -159,3 +159,22 @@ def test_a_handler_routine_of_the_module_is_named_as_missing_from_the_output() -
     assert line.span.line == 24
     assert "runs from the interrupt at line 11" in line.reason
     assert "does not hold" in line.reason
+
+
+def test_interrupts_and_triggers_take_no_time() -> None:
+    """Passes time the declarations and switches as instant and do not time a trigger's
+    action: the cycle time never includes what an interrupt or a trigger runs."""
+    import olp
+    from olp.frontends.bundled import KrlOptions
+
+    station = olp.load_station(REPO / "stations" / "kr6_milling_cell.yaml")
+    result = olp.build(
+        station,
+        CORPUS / "Program" / "trigger_dispense.src",
+        post="kuka",
+        program_options=KrlOptions(config_dat=CONFIG),
+        collisions=None,
+    )
+    kinds = ("interrupt_decl", "interrupt", "trigger")
+    steps = [s for s in result.compiled.flat().steps if s.instruction.kind in kinds]
+    assert len(steps) == 11 and all(s.duration == 0.0 for s in steps)
