@@ -30,6 +30,7 @@ from olp.ir import Frame, Instruction, LinearPath, Program, Tool, is_motion
 if TYPE_CHECKING:
     from collections.abc import Iterable
 
+    from olp.passes.timing.branches import PathTimes
     from olp.span import SourceSpan
     from olp.station.model import Station
     from olp.trajectory import Segment, TimeLaw
@@ -204,13 +205,16 @@ def items_of(steps: Sequence[Step]) -> tuple[Item, ...]:
 
 @dataclass(frozen=True, slots=True, eq=False)
 class CompiledProgram:
-    """A program resolved on a station: steps (one per instruction) and diagnostics."""
+    """A program resolved on a station: steps (one per instruction) and diagnostics;
+    ``paths``: for a program with control flow, its cycle time per path (the timing pass's
+    :func:`~olp.passes.timing.branches.path_times`), else None."""
 
     program: Program
     station: Station
     start_joints: FloatArray
     steps: Sequence[Step]
     diagnostics: tuple[Diagnostic, ...] = field(default=())
+    paths: PathTimes | None = None
 
     @property
     def ok(self) -> bool:

@@ -4,7 +4,11 @@ Stable JSON keys (kept from the first release on): ``program``, ``post``, ``file
 ``cycle_time_s``, ``instructions`` (``index``, ``kind``, ``source``, ``joints_deg`` for motions,
 ``time_s``) and ``diagnostics`` (``severity``, ``kind``, ``message``, ``source``). New keys may be
 added; these are not renamed or removed. Added since: ``path_length_m`` (total and per motion,
-TCP travel) and ``start_s`` per instruction (its start time in the cycle).
+TCP travel) and ``start_s`` per instruction (its start time in the cycle), and for a program
+with control flow ``paths`` (:func:`paths_dict`: the shortest and longest path's time and the
+branch choices that give each, what was assumed, how loops were counted); there
+``cycle_time_s`` is the longest path's time (the named path's, when ``--assume`` decides every
+branch), while ``start_s`` and ``time_s`` follow the text, each instruction once.
 
 The timing tables of ``olp time`` (:func:`timing_summary`, :func:`timing_table`,
 :func:`sweep_table`) live here too.
@@ -30,6 +34,7 @@ if TYPE_CHECKING:
     from numpy.typing import NDArray
 
     from olp.compiled import CompiledProgram
+    from olp.passes.timing.branches import Choice, PathTimes
 
 SCHEMA_VERSION = 1
 
@@ -58,7 +63,7 @@ def report_dict(result: BuildResult) -> dict[str, Any]:
             item["path_length_m"] = round(step.path_length, 9)
             item["skipped"] = step.skipped
         instructions.append(item)
-    return {
+    out: dict[str, Any] = {
         "schema": SCHEMA_VERSION,
         "program": compiled.program.name,
         "source": compiled.program.source,
@@ -67,11 +72,44 @@ def report_dict(result: BuildResult) -> dict[str, Any]:
         "post": result.post,
         "ok": result.ok,
         "files": [str(p) for p in result.written],
-        "cycle_time_s": round(compiled.cycle_time, 6) if compiled.ok else None,
+        "cycle_time_s": round(_cycle_time(compiled), 6) if compiled.ok else None,
         "path_length_m": round(_path_length(compiled), 9) if compiled.ok else None,
         "instructions": instructions,
         "diagnostics": [d.to_json() for d in result.diagnostics],
     }
+    if compiled.paths is not None:
+        out["paths"] = paths_dict(compiled.paths)
+    return out
+
+
+def _cycle_time(compiled: CompiledProgram) -> float:
+    """The cycle time: the text's, or with control flow the longest path's."""
+    paths = compiled.paths
+    if paths is not None and paths.longest is not None:
+        return paths.longest.seconds
+    return compiled.cycle_time
+
+
+def paths_dict(paths: PathTimes) -> dict[str, Any]:
+    """The report's ``paths``: ``shortest_s``/``longest_s`` (None when the program could not be
+    walked, ``reason`` says why), ``shortest_choices``/``longest_choices`` (``source``
+    file:line:column of the block, ``choice``, ``count``), ``decided``, ``assumed``, ``notes``."""
+    ends = {"shortest": paths.shortest, "longest": paths.longest}
+    out: dict[str, Any] = {
+        "decided": paths.decided,
+        "assumed": list(paths.assumed),
+        "notes": list(paths.notes),
+        "reason": paths.reason,
+    }
+    for name, end in ends.items():
+        out[f"{name}_s"] = None if end is None else round(end.seconds, 6)
+        out[f"{name}_choices"] = [] if end is None else [_choice(c) for c in end.choices]
+    return out
+
+
+def _choice(choice: Choice) -> dict[str, Any]:
+    block, _, taken = choice.text.partition("\t")
+    return {"source": str(choice.span), "choice": f"{block} {taken}", "count": choice.count}
 
 
 def report_json(result: BuildResult) -> str:
@@ -92,12 +130,8 @@ def summary(result: BuildResult) -> str:
         ("station", f"{compiled.station.name} ({compiled.station.robot.name})"),
         ("instructions", f"{len(steps)} ({len(motions)} motions)"),
         ("reachability", _verdict(len(motions), len(resolved), errors)),
-        (
-            "cycle time",
-            f"{quantity(compiled.cycle_time, 2)} s ({_timing_note(compiled)})"
-            if compiled.ok
-            else "-",
-        ),
+        ("cycle time", _cycle_line(compiled, 2) if compiled.ok else "-"),
+        *(_path_rows(compiled.paths) if compiled.ok and compiled.paths else []),
         (
             "path length",
             f"{_path_length(compiled) * 1000:.1f} mm of TCP travel" if compiled.ok else "-",
@@ -107,7 +141,49 @@ def summary(result: BuildResult) -> str:
     if result.written:
         rows.append(("written", written_line(result.written)))
     width = max(len(k) for k, _ in rows)
-    return "\n".join(f"{k.ljust(width)}  {v}" for k, v in rows)
+    text = "\n".join(f"{k.ljust(width)}  {v}" for k, v in rows)
+    table = path_table(compiled.paths) if compiled.ok and compiled.paths else ""
+    return f"{text}\n\n{table}" if table else text
+
+
+def _cycle_line(compiled: CompiledProgram, decimals: int, pointer: bool = True) -> str:
+    """The cycle time and how to read it: one number, or with control flow the range of its
+    paths (:func:`path_table` lists the choices)."""
+    paths = compiled.paths
+    note = _timing_note(compiled, pointer)
+    if paths is None:
+        return f"{quantity(compiled.cycle_time, decimals)} s ({note})"
+    if paths.shortest is None or paths.longest is None:
+        text = quantity(compiled.cycle_time, decimals)
+        return f"{text} s (the text in order, each instruction once: {paths.reason})"
+    lo, hi = quantity(paths.shortest.seconds, decimals), quantity(paths.longest.seconds, decimals)
+    if paths.decided:
+        how = "the path --assume names" if paths.assumed else "the only path"
+        return f"{hi} s ({how}; {note})"
+    return f"{lo} .. {hi} s (shortest .. longest path, see below; {note})"
+
+
+def _path_rows(paths: PathTimes) -> list[tuple[str, str]]:
+    """The summary's rows on paths: what was assumed, how loops were counted."""
+    rows = []
+    if paths.assumed:
+        rows.append(("assumed", ", ".join(paths.assumed)))
+    rows += [("paths", note) for note in paths.notes]
+    return rows
+
+
+def path_table(paths: PathTimes) -> str:
+    """The two ends of the range and the branch choices that give each, one choice a line;
+    empty when one path was named (or none could be timed)."""
+    if paths.decided or paths.shortest is None or paths.longest is None:
+        return ""
+    header = ("path", "time s", "branch choices")
+    rows: list[tuple[str, str, str]] = [header]
+    for name, end in (("shortest", paths.shortest), ("longest", paths.longest)):
+        described = [c.describe() for c in end.choices] or ["(no open choice)"]
+        rows.append((name, quantity(end.seconds, 3), described[0]))
+        rows += [("", "", more) for more in described[1:]]
+    return _columns(rows, right=(1,))
 
 
 WRITTEN_NAMED = 3
@@ -148,17 +224,20 @@ def timing_summary(compiled: CompiledProgram) -> str:
     rows = [
         ("program", f"{compiled.program.name} ({compiled.program.source})"),
         ("station", f"{compiled.station.name} ({compiled.station.robot.name})"),
-        ("cycle time", f"{quantity(compiled.cycle_time, 3)} s ({_timing_note(compiled, False)})"),
+        ("cycle time", _cycle_line(compiled, 3, pointer=False)),
+        *(_path_rows(compiled.paths) if compiled.paths else []),
         ("path length", f"{_path_length(compiled) * 1000:.1f} mm of TCP travel"),
         ("includes", includes),
         ("excludes", excludes),
     ]
     width = max(len(k) for k, _ in rows)
     indent = " " * (width + 2)
-    return "\n".join(
+    text = "\n".join(
         textwrap.fill(v, 96, initial_indent=f"{k.ljust(width)}  ", subsequent_indent=indent)
         for k, v in rows
     )
+    table = path_table(compiled.paths) if compiled.paths else ""
+    return f"{text}\n\n{table}" if table else text
 
 
 def estimate_scope(compiled: CompiledProgram) -> tuple[str, str]:
@@ -192,7 +271,10 @@ def estimate_scope(compiled: CompiledProgram) -> tuple[str, str]:
             m.speed.linear_acceleration is not None or m.speed.angular_acceleration is not None
             for m in path
         )
+        default = compiled.station.robot.limits.path_acceleration
         extra = ", path accelerations" if accels else ""
+        if default is not None:
+            extra += f", the controller's path acceleration of {default:g} m/s²"
         parts.append(
             "linear and circular moves at the shortest time within the axis limits (jerk "
             f"included) and the programmed TCP speed{extra}, zones rounded as blends"
@@ -203,6 +285,18 @@ def estimate_scope(compiled: CompiledProgram) -> tuple[str, str]:
         "settling at exact stops, payload and motor-torque limits, and the time of I/O and "
         "called routines beyond the fixed times"
     )
+    unset = [m for m in path if m.speed.linear_acceleration is None]
+    if unset and not on_ur and compiled.station.robot.limits.path_acceleration is None:
+        excludes += (
+            "; the controller's own path acceleration where the program sets none (unknown "
+            "to the station: olp time --calibrate fits it from a recording)"
+        )
+    if compiled.paths is not None and compiled.paths.shortest is not None:
+        excludes += (
+            "; with control flow, a blend from one block into the next (across an IF, a loop's "
+            "head or end) counts as an exact stop, and the path length and the per-instruction "
+            "times follow the text, each instruction once"
+        )
     stops = sum(1 for d in compiled.diagnostics if d.kind == "zone_stop")
     if stops:
         excludes += (
@@ -218,7 +312,7 @@ def _sentence(text: str) -> str:
 
 def timing_table(compiled: CompiledProgram) -> str:
     """Per instruction: index, kind, source file:line, TCP path length (mm), time (s), with a
-    total line."""
+    total line (with control flow: each instruction once, in the text's order)."""
     header = ("#", "kind", "source", "path mm", "time s")
     rows = [
         (
@@ -232,7 +326,7 @@ def timing_table(compiled: CompiledProgram) -> str:
     ]
     total = (
         "",
-        "total",
+        "total" if compiled.paths is None else "text total",
         "",
         quantity(_path_length(compiled) * 1000, 2),
         quantity(compiled.cycle_time, 3),

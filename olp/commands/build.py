@@ -7,15 +7,15 @@ import sys
 
 from olp.commands.common import EXIT_OK, EXIT_PROGRAM_ERRORS, print_diagnostics, require_files
 from olp.commands.options import (
+    add_assume_option,
     add_check_options,
     add_collision_options,
     add_output_options,
     add_program,
     add_program_options,
+    build_options,
     check_report_paths,
-    collision_options,
     program_options,
-    resolve_options,
     write_outputs,
 )
 
@@ -33,6 +33,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("-q", "--quiet", action="store_true", help="print errors only")
     add_check_options(parser)
     add_collision_options(parser)
+    add_assume_option(parser)
     add_program_options(parser)
 
 
@@ -43,6 +44,7 @@ def run(args: argparse.Namespace) -> int:
 
     require_files(args.station, args.program)
     check_report_paths(args)
+    options = build_options(args)
     with progress.showing(progress.terminal_reporter(args.quiet)):
         result = build(
             args.station,
@@ -50,9 +52,8 @@ def run(args: argparse.Namespace) -> int:
             post=args.post,
             out_dir=args.out,
             name=args.name,
-            options=resolve_options(args),
+            options=options,
             program_options=program_options(args),
-            collisions=collision_options(args),
         )
     print_diagnostics(result.diagnostics, args.program, quiet=args.quiet)
     write_outputs(args, result)

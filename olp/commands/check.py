@@ -9,15 +9,15 @@ import argparse
 
 from olp.commands.common import EXIT_OK, EXIT_PROGRAM_ERRORS, print_diagnostics, require_files
 from olp.commands.options import (
+    add_assume_option,
     add_check_options,
     add_collision_options,
     add_output_options,
     add_program,
     add_program_options,
+    build_options,
     check_report_paths,
-    collision_options,
     parse_program,
-    resolve_options,
     write_outputs,
 )
 
@@ -30,6 +30,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_program(parser)
     add_check_options(parser)
     add_collision_options(parser)
+    add_assume_option(parser)
     add_output_options(parser)
     parser.add_argument("-q", "--quiet", action="store_true", help="print errors only")
     add_program_options(parser)
@@ -42,13 +43,12 @@ def run(args: argparse.Namespace) -> int:
 
     require_files(args.station, args.program)
     check_report_paths(args)
+    options = build_options(args)
     station = load_station(args.station)
     with progress.showing(progress.terminal_reporter(args.quiet)):
         with progress.stage("read"):
             parsed = parse_program(args, station)
-        compiled = compile(
-            parsed.program, station, resolve_options(args), collisions=collision_options(args)
-        )
+        compiled = compile(parsed.program, station, options)
     result = BuildResult(compiled, "-", parsed.notes + compiled.diagnostics)
     print_diagnostics(result.diagnostics, args.program, quiet=args.quiet)
     write_outputs(args, result)

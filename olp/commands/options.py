@@ -1,6 +1,7 @@
 """The option groups the ``olp`` commands share, and what the parsed options mean.
 
 * check options (``--fallback``, ``--skip-unreachable``) -> :func:`resolve_options`;
+* ``--assume`` (what a program's branches and loops may take as known) -> :func:`build_options`;
 * collision options (``--no-collisions``, ``--clearance`` ...) -> :func:`collision_options`;
 * output options (``--report``, ``--sarif``) -> :func:`check_report_paths`, :func:`write_outputs`;
 * the program and its options: one argument group per set of frontends that take the same flags,
@@ -15,7 +16,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -24,6 +25,7 @@ if TYPE_CHECKING:
     from olp.frontends import Frontend, ParsedProgram
     from olp.frontends.options import Flag
     from olp.passes.collide import CollisionOptions
+    from olp.passes.pipeline import BuildOptions
     from olp.passes.resolve import ResolveOptions
     from olp.station.model import Station
 
@@ -52,6 +54,39 @@ def resolve_options(args: argparse.Namespace) -> ResolveOptions:
 
     return ResolveOptions(
         fallback_joint=args.fallback == "joint", skip_unreachable=args.skip_unreachable
+    )
+
+
+ASSUME_HELP = (
+    "what the cycle time of a program with branches and loops may take as known, repeatable: "
+    "an input (in3=true, or $IN[3]=true), a variable (count=4, part.kind=#BIG, name='A'), the "
+    "passes of a loop by its source line, file and line, or the label before it (loop:12=5, "
+    "loop:sub.src:40=3, loop:retry=2). "
+    "Without it, the cycle time is a range: the shortest and the longest path with the branch "
+    "choices that give each; a WHILE, REPEAT or LOOP whose count is unknown counts one pass"
+)
+
+
+def add_assume_option(parser: argparse.ArgumentParser) -> None:
+    """``--assume NAME=VALUE`` (:mod:`olp.passes.timing.conditions`)."""
+    parser.add_argument(
+        "--assume", action="append", default=[], metavar="NAME=VALUE", help=ASSUME_HELP
+    )
+
+
+def build_options(
+    args: argparse.Namespace, other_times: Mapping[str, float] | None = None
+) -> BuildOptions:
+    """The :class:`~olp.passes.pipeline.BuildOptions` the check, collision and ``--assume``
+    options ask for."""
+    from olp.passes.pipeline import BuildOptions
+    from olp.passes.timing.conditions import parse_assumptions
+
+    return BuildOptions(
+        resolve=resolve_options(args),
+        collisions=collision_options(args),
+        other_times=other_times or {},
+        assume=parse_assumptions(getattr(args, "assume", [])),
     )
 
 

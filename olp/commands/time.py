@@ -7,10 +7,16 @@ every joint move. Accelerations and orientation-speed limits stay as programmed.
 the two options, that dimension keeps the programmed speeds.
 
 ``olp time STATION --calibrate LOG.csv [--output OVERRIDE.yaml]`` fits the station robot's
-per-axis velocity, acceleration and jerk limits to a recorded joint trajectory (olp's own
-trajectory CSV, or a UR RTDE recording) and writes them as a station override (printed without
-``--output``), with the residual of re-timing the recording with them
+per-axis velocity, acceleration and jerk limits, and the controller's path acceleration from
+its straight-line moves (of the ``--calibrate-tool`` TCP), to a recorded joint trajectory (olp's
+own trajectory CSV, or a UR RTDE recording) and writes them as a station override (printed
+without ``--output``), with the residual of re-timing the recording with them
 (:mod:`olp.passes.timing.calibrate`).
+
+A program with branches and loops is timed per path: the shortest and the longest path, with
+the branch choices that give each, or the path ``--assume`` names (inputs ``in3=true``,
+variables ``count=4``, loop passes ``loop:12=5``; :mod:`olp.passes.timing.branches`). The table
+per instruction and the trajectory follow the text, each instruction once.
 
 Exit codes as for ``olp build``: 0 timed, 1 the program has errors, 2 bad input.
 """
@@ -25,13 +31,13 @@ from typing import TYPE_CHECKING
 
 from olp.commands.common import EXIT_OK, EXIT_PROGRAM_ERRORS, print_diagnostics, require_files
 from olp.commands.options import (
+    add_assume_option,
     add_check_options,
     add_collision_options,
     add_program,
     add_program_options,
-    collision_options,
+    build_options,
     parse_program,
-    resolve_options,
 )
 from olp.errors import UsageError
 
@@ -52,11 +58,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--calibrate",
         metavar="LOG.csv",
         help="instead of a program: fit the robot's joint velocity, acceleration and jerk "
-        "limits to this recorded trajectory (time_s + j1_deg.. columns, or UR RTDE's timestamp "
-        "+ actual_q_0..) and print them as a station override",
+        "limits (and the controller's path acceleration, from its straight-line moves) to this "
+        "recorded trajectory (time_s + j1_deg.. columns, or UR RTDE's timestamp + "
+        "actual_q_0..) and print them as a station override",
     )
     parser.add_argument(
         "--output", metavar="YAML", help="with --calibrate: write the station override here"
+    )
+    parser.add_argument(
+        "--calibrate-tool",
+        metavar="NAME",
+        help="with --calibrate: the station tool whose TCP ran the recorded path moves (to find "
+        "them and fit the path acceleration; default: the flange)",
     )
     parser.add_argument(
         "--sweep-linear",
@@ -81,6 +94,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="time charged for an instruction kind (set_output, wait_input, call, comment) or a "
         "named call (call:NAME); repeatable, e.g. --time call:SprayOn=1.5",
     )
+    add_assume_option(parser)
     add_check_options(parser)
     add_collision_options(parser)
     add_program_options(parser)
@@ -95,12 +109,13 @@ def run(args: argparse.Namespace) -> int:
 
     if args.calibrate is not None or args.program is None:
         return calibrate(args)
-    if args.output is not None:
-        raise UsageError("--output goes with --calibrate")
+    if args.output is not None or args.calibrate_tool is not None:
+        raise UsageError("--output and --calibrate-tool go with --calibrate")
     require_files(args.station, args.program)
     linear = _speed_list(args.sweep_linear, "--sweep-linear", "mm/s", 1e-3)
     joint = _speed_list(args.sweep_joint, "--sweep-joint", "%", 1e-2, upper=1.0)
     other_times = parse_times(args.time)
+    options = build_options(args, other_times)
     if not (math.isfinite(args.dt) and args.dt > 0):
         raise UsageError(f"--dt must be a positive number of seconds, got {args.dt}")
     _check_paths(args)
@@ -112,13 +127,7 @@ def run(args: argparse.Namespace) -> int:
     with progress.showing(progress.terminal_reporter(args.quiet)):
         with progress.stage("read"):
             parsed = parse_program(args, station)
-        compiled = compile(
-            parsed.program,
-            station,
-            resolve_options(args),
-            collisions=collision_options(args),
-            other_times=other_times,
-        )
+        compiled = compile(parsed.program, station, options)
     print_diagnostics(parsed.notes + compiled.diagnostics, args.program, quiet=args.quiet)
     if not compiled.ok:
         return EXIT_PROGRAM_ERRORS
@@ -145,10 +154,26 @@ def calibrate(args: argparse.Namespace) -> int:
     station = load_station(args.station)
     text = Path(args.calibrate).read_text(encoding="utf-8", errors="replace")
     recording = read_recording(text, args.calibrate, station.robot.dof)
-    fitted = fit_limits(recording, station.robot)
+    tool = None
+    if args.calibrate_tool is not None:
+        found = station.tools.get(args.calibrate_tool)
+        if found is None or found.pose is None:
+            known = ", ".join(sorted(station.tools)) or "none"
+            raise UsageError(
+                f"--calibrate-tool: the station has no tool {args.calibrate_tool!r} (its tools: "
+                f"{known})"
+            )
+        tool = found.pose
+    fitted = fit_limits(recording, station, tool)
     override = override_yaml(fitted, Path(args.calibrate).name)
+    path = (
+        f", path acceleration {fitted.path_acceleration:.3f} m/s² from {fitted.path_moves} "
+        "path move(s)"
+        if fitted.path_acceleration is not None
+        else ", no path move (no path acceleration)"
+    )
     print(
-        f"fitted {station.robot.name} to {fitted.moves} recorded move(s): re-timed "
+        f"fitted {station.robot.name} to {fitted.moves} recorded move(s){path}: re-timed "
         f"{fitted.retimed:.3f} s against {fitted.recorded:.3f} s recorded "
         f"(residual {fitted.residual * 100:+.2f} %)"
     )

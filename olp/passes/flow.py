@@ -11,8 +11,7 @@ its path stays within the joint limits between two ends within them).
 
 What is approximated, and said so in a note: collisions are checked only along the text's
 order; the configuration a path from another start would take is the one resolve picks for
-that start alone. Timing (:func:`flow_timing_note`) times the text in order, each instruction
-once: with branches and loops that is not one run of the program, and the note says so.
+that start alone. The cycle time per path is :mod:`olp.passes.timing.branches`'.
 """
 
 from __future__ import annotations
@@ -197,23 +196,6 @@ def _collision_note(count: int) -> Diagnostic:
         "reach, limits and singularities, not for collisions (olp checks collisions along the "
         "text's order)",
     )
-
-
-def flow_timing_note(compiled: CompiledProgram, options: Any) -> CompiledProgram:
-    """Say that the cycle time of a program with control flow is the text's, in order."""
-    program = compiled.program
-    if not program.has_flow:
-        return compiled
-    first = next(n for n in leaves_and_blocks(program.instructions) if _is_flow(n))
-    note = Diagnostic(
-        "info",
-        "flow_timing",
-        f"the program has control flow (first: {first.kind.replace('_', ' ')} at line "
-        f"{first.span.line}): the cycle time times every instruction once, in the order of the "
-        "text; that is not one run of the program (no branch is chosen, no loop repeated)",
-        first.span,
-    )
-    return compiled.with_diagnostics([note])
 
 
 def _is_flow(node: Any) -> bool:

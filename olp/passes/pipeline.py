@@ -23,9 +23,11 @@ from olp import progress
 from olp.compiled import CompiledProgram
 from olp.ir import Program
 from olp.passes.collide import CollisionOptions, collision_pass
-from olp.passes.flow import flow_pass, flow_timing_note
+from olp.passes.flow import flow_pass
 from olp.passes.resolve import ResolveOptions, resolve_pass
 from olp.passes.timing import TimingOptions, timing_pass
+from olp.passes.timing.branches import path_timing_pass
+from olp.passes.timing.conditions import Assumptions
 from olp.station.model import Station
 
 
@@ -36,13 +38,16 @@ class BuildOptions:
     ``resolve``: sampling, fallbacks and skipping of the resolve pass; ``collisions``: the
     collision check's options, or None to skip it; ``timing``: discretisation and solvers of the
     timing pass; ``other_times``: seconds per non-motion instruction kind or named call
-    (``"call:NAME"``), over :data:`olp.passes.timing.DEFAULT_TIMES`.
+    (``"call:NAME"``), over :data:`olp.passes.timing.DEFAULT_TIMES`; ``assume``: what the
+    cycle time of a program with control flow may take as known (``--assume``: inputs,
+    variables, loop counts; :mod:`olp.passes.timing.conditions`).
     """
 
     resolve: ResolveOptions = field(default_factory=ResolveOptions)
     collisions: CollisionOptions | None = field(default_factory=CollisionOptions)
     timing: TimingOptions = field(default_factory=TimingOptions)
     other_times: Mapping[str, float] = field(default_factory=dict)
+    assume: Assumptions = field(default_factory=Assumptions)
 
 
 Pass = Callable[[CompiledProgram, BuildOptions], CompiledProgram]
@@ -53,7 +58,7 @@ PIPELINE: tuple[Pass, ...] = (
     flow_pass,
     collision_pass,
     timing_pass,
-    flow_timing_note,
+    path_timing_pass,
 )
 """What a build runs."""
 

@@ -234,7 +234,7 @@ class Post:
         language cannot write (:attr:`ACCELERATIONS`), on the first such move's line."""
         out = []
         for name in ("linear_acceleration", "angular_acceleration"):
-            if name in self.ACCELERATIONS:
+            if name in self.ACCELERATIONS and self.manifest.accelerations:
                 continue
             moves = [
                 step
@@ -249,6 +249,12 @@ class Post:
                     f"{len(moves)} path move(s): the controller's own applies, and the cycle "
                     "time differs from the estimate"
                 )
+                if name in self.ACCELERATIONS:
+                    msg += (
+                        f" (the template folder {self.manifest.folder.name} does not declare "
+                        "accelerations: true; a copy of an older post: copy the bundled "
+                        "templates' acceleration lines and declare it)"
+                    )
                 out.append(_warning("acceleration", msg, moves[0]))
         return out
 

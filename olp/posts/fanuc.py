@@ -64,6 +64,12 @@ endings (the files are DOS text; medium confidence that LF would also do).
   at 1 is certain, the end is unverified; a template folder may set the option ``io_range``).
 * Numbers: positions and frames are 32-bit REALs on the controller (medium confidence), held to
   0.01 mm; J speeds 1..100 %, CNT 0..100, integer mm/sec >= 1.
+* Control flow and data (``WRITES_FLOW``): blocks lowered to ``LBL[n]``/``JMP LBL[n]``,
+  ``IF ...,JMP``, ``SELECT``, ``FOR``/``ENDFOR``, ``WAIT (...)``, variables in ``R[]``/``PR[]``
+  (post options ``registers``, ``position_registers``, ``mixed_logic``), by
+  :mod:`olp.posts.fanuc_flow` (conventions and sources there); the first motion after a block
+  boundary or label sets ``UFRAME_NUM``/``UTOOL_NUM`` again. What LS cannot express is a
+  ``flow`` error on its line.
 * Long programs are split (:mod:`olp.transforms.split`, the manifest's ``limits``) into parts
   ``NAME_P1`` ... and a main program of ``CALL`` lines. The bound is RoboDK's public Fanuc post
   default of 9999 lines per program (``MAX_LINES_X_PROG``; not a documented Fanuc figure),
@@ -85,6 +91,7 @@ from numpy.typing import ArrayLike, NDArray
 from olp.diagnostics import Diagnostic
 from olp.geometry import inv
 from olp.posts.base import Filter, Post
+from olp.posts.fanuc_flow import FLOW_KINDS, lower
 from olp.posts.numbers import NumberError, NumberFormat, Storage
 from olp.posts.rows import PostRows
 from olp.posts.sandbox import SafeText
@@ -252,12 +259,16 @@ def ls_moves(
 ) -> dict[int, LsMove | LsRows]:
     """Template filter ``steps | ls_moves(robot, options)``: the LS motion of every motion of
     one file (template view steps, in order), by instruction index. Positions are numbered from
-    1 in each file; ``UFRAME_NUM``/``UTOOL_NUM`` are set before the file's first motion and
-    where they change."""
+    1 in each file; ``UFRAME_NUM``/``UTOOL_NUM`` are set before the file's first motion, where
+    they change, and at the first motion after a block boundary or label (the motion before it
+    in the text need not be the one that ran: :data:`JUMP_TARGETS`)."""
     out: dict[int, LsMove | LsRows] = {}
     last: tuple[int, int] | None = None
     number = 0
     for step in steps:
+        if step.kind in JUMP_TARGETS:
+            last = None
+            continue
         if isinstance(step, PostRows):
             moves = _row_moves(post, step, number, last, options)
             out[step.index] = LsRows(step, moves)
@@ -280,6 +291,25 @@ def ls_moves(
         last = (uf, ut)
     post.current_step = None
     return out
+
+
+JUMP_TARGETS = FLOW_KINDS - {"declare", "assign", "wait_until", "goto", "exit", "return"}
+"""Step kinds after which the program may arrive from elsewhere (block markers, labels)."""
+
+
+def ls_flow(
+    post: Post, steps: Sequence[PostStep | PostRows], options: Mapping[str, Any]
+) -> tuple[SafeText, ...]:
+    """Template filter ``steps | ls_flow(options)``: per step of a file (by position), the /MN
+    lines of a control-flow or data step (:func:`olp.posts.fanuc_flow.lower`), empty for any
+    other step. They are built from checked pieces (register and label numbers, comments of
+    letters, digits and ``_``, checked numbers). What LS cannot express becomes an error on its
+    line (:meth:`FanucPost.check_program` reports the same before rendering)."""
+    lowered = lower(((s.kind, s.instruction) for s in steps), options, post.io_range)
+    for node, message in lowered.problems:
+        text = f"{_what(node)} cannot be written in LS: {message}"
+        post.problems.append(Diagnostic("error", "flow", text, getattr(node, "span", None)))
+    return tuple(SafeText("\n".join(lines)) for lines in lowered.lines)
 
 
 def _row_moves(
@@ -456,6 +486,7 @@ FILTERS: Mapping[str, Filter] = {
     "ls_joint_field": _joint_filter,
     "ls_rows_mn": ls_rows_mn,
     "ls_rows_pos": ls_rows_pos,
+    "ls_flow": ls_flow,
 }
 
 
@@ -466,6 +497,7 @@ class FanucPost(Post):
     VENDOR = "fanuc"
     LANGUAGE = "LS"
     ROWS = True
+    WRITES_FLOW = True
     NAME_RULE = NAME_RULE
     COMMENTS = CommentRule(max_length=COMMENT_LENGTH, replace=((";", ","),), collapse=True)
     IO_RANGE = (1, 4096)
@@ -525,7 +557,38 @@ class FanucPost(Post):
         motions = [s for s in compiled.steps if s.joints is not None]
         out = _frame_checks(self, motions, robot)
         out += _tool_checks(self, motions, self.options)
-        return out + _joint_position_notes(self, motions, robot)
+        return out + _joint_position_notes(self, motions, robot) + _flow_checks(self, compiled)
+
+
+def _flow_checks(post: Post, compiled: CompiledProgram) -> list[Diagnostic]:
+    """* ``flow`` (error): a control-flow or data statement LS cannot express
+    (:mod:`olp.posts.fanuc_flow`), on its line;
+    * ``declaration_dropped`` (warning): a declaration of a type LS has no register for (text,
+      structures); using the variable is an error."""
+    if not compiled.program.has_flow:
+        return []
+    from olp.posts.flow import weave
+    from olp.posts.view import PostStep
+
+    steps = [PostStep(s.index, s.instruction.kind, "", s.instruction) for s in compiled.steps]
+    events = [(s.kind, s.instruction) for s in weave(compiled.program, steps)]
+    lowered = lower(events, post.options, post.io_range)
+    out = [
+        Diagnostic("error", "flow", f"{_what(node)} cannot be written in LS: {msg}", node.span)
+        for node, msg in lowered.problems
+    ]
+    for decl in lowered.unwritten:
+        msg = (
+            f"declaration of {decl.name} ({decl.type_name}) is not written: LS has no register "
+            "for that type"
+        )
+        out.append(Diagnostic("warning", "declaration_dropped", msg, decl.span))
+    return out
+
+
+def _what(node: Any) -> str:
+    kind = getattr(node, "kind", None) or type(node).__name__.lower()
+    return str(kind).replace("_", " ")
 
 
 def _first_use(motions: Sequence[Any], attr: str) -> dict[str, Any]:

@@ -19,6 +19,10 @@ The manifest says::
     rows: true                        # the templates write a "rows" step (runs of linear moves)
                                       # with the post's row writer (default false: one step
                                       # per move, as a copied folder of an older post has it)
+    accelerations: true               # the templates write the path accelerations the post
+                                      # class can (default false: a folder copied before olp
+                                      # wrote them; the post then warns where a program sets
+                                      # one)
     options: {...}                    # free-form: templates see them as `options`, and so does
                                       # the post class
 
@@ -59,6 +63,7 @@ class PostManifest:
     limits: SplitLimits = field(default_factory=SplitLimits)
     frames_in: str = "world"
     rows: bool = False
+    accelerations: bool = False
 
 
 def load_manifest(folder: Path) -> PostManifest:
@@ -76,9 +81,7 @@ def load_manifest(folder: Path) -> PostManifest:
     frames_in = str(raw.get("frames_in", "world"))
     if frames_in not in FRAMES_IN:
         raise PostError(f"{path}: frames_in must be one of {', '.join(FRAMES_IN)}")
-    rows = raw.get("rows", False)
-    if not isinstance(rows, bool):
-        raise PostError(f"{path}: rows must be true or false, got {rows!r}")
+    rows, accelerations = (_flag(raw, key, path) for key in ("rows", "accelerations"))
     return PostManifest(
         name=str(raw.get("name", folder.name)),
         vendor=str(raw.get("vendor", "")),
@@ -92,7 +95,15 @@ def load_manifest(folder: Path) -> PostManifest:
         limits=limits,
         frames_in=frames_in,
         rows=rows,
+        accelerations=accelerations,
     )
+
+
+def _flag(raw: Mapping[str, Any], key: str, path: Path) -> bool:
+    value = raw.get(key, False)
+    if not isinstance(value, bool):
+        raise PostError(f"{path}: {key} must be true or false, got {value!r}")
+    return value
 
 
 def _file_entries(entries: Any, folder: Path, path: Path) -> tuple[tuple[str, str], ...]:

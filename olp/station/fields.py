@@ -81,6 +81,7 @@ MASS = Range("a mass in kg", 0.0, 1e5, positive=True)
 SPEED = Range("a joint speed in deg/s", 0.1, 1e4)
 ACCELERATION = Range("a joint acceleration in deg/s²", 0.1, 1e6)
 JERK = Range("a joint jerk in deg/s³", 0.1, 1e8)
+PATH_ACCELERATION = Range("a TCP path acceleration in m/s²", 1e-3, 1e3)
 
 MAX_CONTROLLER_INTEGER = 2**31 - 1
 MAX_NAME = 100

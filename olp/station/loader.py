@@ -71,6 +71,7 @@ from olp.station.fields import (
     LENGTH,
     MASS,
     MAX_CONTROLLER_INTEGER,
+    PATH_ACCELERATION,
     QUATERNION,
     SIZE,
     SPEED,
@@ -238,9 +239,10 @@ _RATE_LIMITS = {
 
 
 def _limits(
-    src: Source, value: Any, path: KeyPath, base: JointLimits | None, dof: int
+    src: Source, value: Any, path: KeyPath, base: JointLimits | None, dof: int, vendor: str
 ) -> JointLimits:
     check_keys(src, value, path, KEYS["limits"])
+    path_acceleration = _path_acceleration(src, value, path, vendor)
     fields: dict[str, np.ndarray] = {}
     if value.get("position_deg") is not None:
         fields["lower"], fields["upper"] = _position_limits(
@@ -254,8 +256,26 @@ def _limits(
         missing = [n for n in names if n not in fields]
         if missing:
             raise src.error(path, f"missing limits: {', '.join(missing)}")
-        return JointLimits(**fields)
-    return JointLimits(**{n: fields.get(n, getattr(base, n)) for n in names})
+        return JointLimits(**fields, path_acceleration=path_acceleration)
+    if path_acceleration is None:
+        path_acceleration = base.path_acceleration
+    merged = {n: fields.get(n, getattr(base, n)) for n in names}
+    return JointLimits(**merged, path_acceleration=path_acceleration)
+
+
+def _path_acceleration(src: Source, value: Any, path: KeyPath, vendor: str) -> float | None:
+    """``path_acceleration_m_s2``: the controller's default TCP path acceleration (m/s²)."""
+    key = "path_acceleration_m_s2"
+    if value.get(key) is None:
+        return None
+    if vendor == "ur":
+        raise src.error(
+            (*path, key),
+            "a UR program states the tool acceleration (a=) on every movel, so the arm has no "
+            "default path acceleration: set it in the program (KRL $ACC.CP, DSL "
+            "setAcceleration)",
+        )
+    return number(src, value[key], (*path, key), PATH_ACCELERATION)
 
 
 def _position_limits(
@@ -342,7 +362,7 @@ def _model(src: Source, value: dict[str, Any], path: KeyPath) -> RobotModel:
     kin_path: KeyPath = (*path, "kinematics")
     kinematics, links = _kinematics(src, get(src, value, path, "kinematics"), kin_path)
     dof = kinematics.dof
-    limits = _limits(src, limits_value, (*path, "limits"), None, dof)
+    limits = _limits(src, limits_value, (*path, "limits"), None, dof, vendor)
     home = np.radians(numbers(src, home_value, (*path, "home_deg"), dof, ANGLE))
     if np.any(limits.violations(home)):
         raise src.error((*path, "home_deg"), "home position lies outside the joint limits")
@@ -672,7 +692,12 @@ def _station_robot(src: Source, value: Any, path: KeyPath) -> Robot:
     limits = model.limits
     if "limits" in value:
         limits = _limits(
-            src, value["limits"], (*path, "limits"), model.limits, model.kinematics.dof
+            src,
+            value["limits"],
+            (*path, "limits"),
+            model.limits,
+            model.kinematics.dof,
+            model.vendor,
         )
     home = model.home
     if "home_deg" in value:

@@ -7,6 +7,7 @@ in :mod:`olp.station.loader`.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -35,13 +36,19 @@ def _frozen(value: ArrayLike, shape: tuple[int, ...]) -> FloatArray:
 @dataclass(frozen=True, slots=True, eq=False)
 class JointLimits:
     """Per-joint limits, shape (dof,) each: position (rad), velocity (rad/s), acceleration
-    (rad/s²), jerk (rad/s³). Controller joint convention."""
+    (rad/s²), jerk (rad/s³). Controller joint convention.
+
+    ``path_acceleration`` (m/s², optional): the controller's own TCP path acceleration, which
+    bounds path moves whose program sets none (KUKA's ``$ACC.CP`` default from the BAS
+    initialisation; fitted by ``olp time --calibrate``). None: only the joints bound it.
+    """
 
     lower: FloatArray
     upper: FloatArray
     velocity: FloatArray
     acceleration: FloatArray
     jerk: FloatArray
+    path_acceleration: float | None = None
 
     def __post_init__(self) -> None:
         dof = np.shape(self.lower)[0] if np.ndim(self.lower) == 1 else -1
@@ -56,6 +63,9 @@ class JointLimits:
         for name in ("velocity", "acceleration", "jerk"):
             if np.any(getattr(self, name) <= 0):
                 raise ValueError(f"joint limits: {name} limits must be positive")
+        a = self.path_acceleration
+        if a is not None and not (math.isfinite(a) and a > 0):
+            raise ValueError("joint limits: the path acceleration must be a positive number")
 
     def violations(self, joints: ArrayLike, tol: float = 1e-9) -> NDArray[np.bool_]:
         """Boolean mask (..., dof): which joints lie outside [lower, upper] (with tolerance)."""

@@ -94,6 +94,13 @@ _LIMITS = _object(
         "velocity_deg_s": _numbers("per joint, deg/s"),
         "acceleration_deg_s2": _numbers("per joint, deg/s²"),
         "jerk_deg_s3": _numbers("per joint, deg/s³"),
+        "path_acceleration_m_s2": {
+            "type": "number",
+            "exclusiveMinimum": 0,
+            "description": "the controller's own TCP path acceleration, m/s², for path moves "
+            "whose program sets none (KUKA $ACC.CP's default; not for UR arms, whose script "
+            "states a= on every movel); olp time --calibrate fits it",
+        },
     },
     description="Joint limits; in a station they override the model's joint by joint list.",
 )

@@ -44,3 +44,27 @@ def test_a_ur_program_names_the_script_trapezoids() -> None:
     includes, excludes = estimate_scope(compiled)
     assert includes.startswith("Joint moves as the movej trapezoid of the a and v")
     assert "linear" not in includes and "upper bound" not in excludes
+
+
+def test_the_controllers_path_acceleration_is_named_where_it_applies() -> None:
+    import dataclasses
+
+    station = olp.load_station(REPO / "stations" / "kr6_milling_cell.yaml")
+    q = np.radians([0, -90, 90, 0, 45, 0])
+    pose = station.robot.flange_poses(q)
+    pose[:3, 3] += [0.0, 0.0, -0.02]
+    moves = (
+        ir.JointMove(target=ir.JointTarget(joints=q)),
+        ir.LinearMove(target=ir.CartesianTarget(pose=pose), speed=ir.Speed(linear=0.1)),
+    )
+    program = ir.Program(name="t", instructions=moves)
+    includes, excludes = estimate_scope(olp.compile(program, station))
+    assert excludes.count("controller's own path acceleration where the program sets none") == 1
+    assert "path acceleration" not in includes
+    limits = dataclasses.replace(station.robot.limits, path_acceleration=0.5)
+    calibrated = dataclasses.replace(
+        station, robot=dataclasses.replace(station.robot, limits=limits)
+    )
+    includes, excludes = estimate_scope(olp.compile(program, calibrated))
+    assert "the controller's path acceleration of 0.5 m/s²" in includes
+    assert "path acceleration" not in excludes

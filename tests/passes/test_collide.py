@@ -409,7 +409,9 @@ def test_displacement_bound_covers_the_real_point_motion(cell: Station) -> None:
 
 
 def _pair_names(message: str) -> tuple[str, str]:
-    pattern = r"(?:moves \d+-\d+: )?(?:self-collision: )?(.+) hits (.+?) (?:at|\(first at) \d+%"
+    pattern = (
+        r"(?:moves \d+-\d+: )?(?:self-collision: )?(.+) hits (.+?) (?:at|\(first at) \d+(?:\.\d+)?%"
+    )
     match = re.search(pattern, message)
     assert match is not None, message
     return match[1], match[2]

@@ -93,4 +93,4 @@ def test_a_linear_move_is_checked_from_every_start_a_path_gives_it(station: obje
     ]
     assert errors[0].message.endswith("(when it starts from the motion at line 3)")
     kinds = {d.kind for d in compiled.diagnostics}
-    assert {"flow_paths", "flow_timing"} <= kinds
+    assert "flow_paths" in kinds and "flow_timing" not in kinds  # with errors: not timed

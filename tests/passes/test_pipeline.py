@@ -44,7 +44,7 @@ def test_the_default_pipeline_is_resolve_collide_time(
         "flow_pass",  # a no-op without control flow (olp.passes.flow)
         "collision_pass",
         "timing_pass",
-        "flow_timing_note",
+        "path_timing_pass",  # per path, with control flow (olp.passes.timing.branches)
     ]
     checked = olp.compile(milling, station, passes=CHECKS)
     assert checked.ok and checked.cycle_time == 0.0  # no timing pass

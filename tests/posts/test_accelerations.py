@@ -126,3 +126,25 @@ def test_row_writers_write_the_accelerations_as_the_templates(post: str, tmp_pat
     }[post]
     for piece in expected:
         assert piece in text
+
+
+@pytest.mark.parametrize("post", ["kuka", "ur", "abb"])
+def test_a_folder_copied_before_accelerations_warns(
+    stations: dict[str, Station], post: str, tmp_path: Path
+) -> None:
+    """A customer's copy of a post folder made before olp wrote accelerations has templates
+    without them and no ``accelerations: true``: it warns, and names the fix."""
+    import shutil
+
+    from olp.posts import find_post
+
+    folder = tmp_path / f"my_{post}"
+    shutil.copytree(find_post(post).manifest.folder, folder)
+    manifest = folder / "post.yaml"
+    manifest.write_text(manifest.read_text().replace("accelerations: true\n", ""))
+    copied = find_post(str(folder))
+    program = _program(stations[post], post, SET)
+    compiled = olp.compile(program, stations[post])
+    linear = [d for d in copied.check(compiled) if "TCP path" in d.message]
+    assert len(linear) == 1 and "does not declare accelerations: true" in linear[0].message
+    assert not [d for d in find_post(post).check(compiled) if "TCP path" in d.message]

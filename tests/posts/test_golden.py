@@ -2,10 +2,12 @@
 
 USERS.md jobs 1-6 on the KUKA cell for the KRL and RAPID posts (RAPID: transpiled), job 5 split
 into parts, the pick program on the ABB cell, and for URScript and LS the milling program (a
-KUKA program transpiled, foreign robot warned) and a native program on their own cells. A change
-to a golden file needs a stated reason in the commit: after a reviewed change, regenerate with
-``OLP_UPDATE_GOLDEN=1 python -m pytest tests/posts/test_golden.py`` (the test then fails once,
-so the variable can never pass CI by accident).
+KUKA program transpiled, foreign robot warned) and a native program on their own cells; for LS
+also two KRL programs with control flow (``flow_mixed`` through a copy of the post with
+``mixed_logic: true``). A change to a golden file needs a stated reason in the commit: after a
+reviewed change, regenerate with ``OLP_UPDATE_GOLDEN=1 python -m pytest
+tests/posts/test_golden.py`` (the test then fails once, so the variable can never pass CI by
+accident).
 """
 
 from __future__ import annotations
@@ -68,6 +70,8 @@ CASES: dict[tuple[str, str], tuple[str, str, dict[str, Any]]] = {
     ("ur", "transpile"): (UR_CELL, TRANSPILE, {}),
     ("fanuc", "job5_milling"): USERS_JOBS["job5_milling"],
     ("fanuc", "transpile"): (FANUC_CELL, TRANSPILE, {}),
+    ("fanuc", "flow_cycle"): (FANUC_CELL, "tests/posts/fanuc_flow/cycle.src", {}),
+    ("fanuc", "flow_mixed"): (FANUC_CELL, "tests/posts/fanuc_flow/mixed.src", {}),
     **{(post, "weld_rounded"): (KUKA_CELL, "examples/weld_rounded.src", {}) for post in ENDINGS},
 }
 SPLIT = [("kuka", "job5_milling_split"), ("abb", "job5_milling_split")]
@@ -75,12 +79,15 @@ SPLIT = [("kuka", "job5_milling_split"), ("abb", "job5_milling_split")]
 
 
 def _post(post: str, job: str, tmp_path: Path) -> str:
-    if not job.endswith("_split"):
+    if not job.endswith(("_split", "_mixed")):
         return post
     folder = tmp_path / f"{post}_small"
     shutil.copytree(find_post(post).manifest.folder, folder)
     manifest = folder / "post.yaml"
-    text = re.sub(r"max_motions_per_file: \d+", "max_motions_per_file: 3", manifest.read_text())
+    if job.endswith("_mixed"):  # a controller with LS mixed logic
+        text = manifest.read_text().replace("mixed_logic: false", "mixed_logic: true")
+    else:
+        text = re.sub(r"max_motions_per_file: \d+", "max_motions_per_file: 3", manifest.read_text())
     manifest.write_text(text)
     return str(folder)
 

@@ -60,7 +60,7 @@ def test_krl_to_krl_keeps_every_statement(station: object, name: str, tmp_path: 
     assert len(list(again.motions())) == len(list(source.motions()))
 
 
-@pytest.mark.parametrize("post", ["abb", "ur", "fanuc"])
+@pytest.mark.parametrize("post", ["abb", "ur"])
 def test_other_posts_stop_on_control_flow_naming_it(station: object, post: str) -> None:
     result = build(station, CORPUS / "Program" / "pick_part.src", post)
     errors = [d for d in result.diagnostics if d.severity == "error"]

@@ -102,7 +102,9 @@ blend), :mod:`~olp.passes.timing.ptp` (Ruckig),
 :mod:`~olp.passes.timing.reachability` (the numpy solver),
 :mod:`~olp.passes.timing.toppra_reference` (the toppra package, loaded only when asked for),
 :mod:`~olp.passes.timing.sweep` (speed sweeps), :mod:`~olp.passes.timing.tcp` (the TCP along
-joint paths) and :mod:`~olp.passes.timing.program` (the pass).
+joint paths), :mod:`~olp.passes.timing.program` (the pass), and for programs with control flow
+:mod:`~olp.passes.timing.branches` (the cycle time per path, a range over open branches) with
+:mod:`~olp.passes.timing.conditions` (``--assume`` and the folding of conditions).
 """
 
 from __future__ import annotations

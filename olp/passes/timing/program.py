@@ -123,15 +123,21 @@ def time_program(
     compiled: CompiledProgram,
     other_times: Mapping[str, float] | None = None,
     options: TimingOptions | None = None,
+    stops: IntArray | None = None,
 ) -> CompiledProgram:
     """A copy of ``compiled`` whose steps carry ``duration`` (s), ``path_length`` (m of TCP
     travel) and, for motions, ``trajectory`` (a :class:`olp.trajectory.Segment`).
 
     Zones timed as stops add an ``info`` diagnostic (kind ``zone_stop``); a motion that cannot
     be timed keeps duration 0 and adds an ``error`` (kind ``timing``). Never raises on a bad
-    program.
+    program. ``stops`` (k,): instruction indices of motions timed as exact stops whatever
+    their zone (the ends of the runs :mod:`~olp.passes.timing.branches` times together).
     """
     table = MotionTable.of(compiled)
+    if stops is not None and stops.size:
+        zone = table.zone.copy()
+        zone[stops] = 0.0
+        table = dataclasses.replace(table, zone=zone)
     lengths = travel(table, compiled.station.robot)
     corners = plan(table, lengths)
     times = Times(table.size)

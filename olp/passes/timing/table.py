@@ -111,6 +111,8 @@ class _Builder:
         self.samples = 0
         self.tools: list[FloatArray] = []
         self.tool_index: dict[int, int] = {}
+        # The controller's own path acceleration bounds path moves that set none.
+        self.path_acceleration = compiled.station.robot.limits.path_acceleration
 
     def table(self) -> MotionTable:
         for item in items_of(self.compiled.steps):
@@ -180,7 +182,7 @@ class _Builder:
         self.linear[i] = speed.linear
         self.angular[i] = np.inf if speed.angular is None else speed.angular
         self.joint[i], self.joint_acceleration[i] = speed.joint, speed.joint_acceleration
-        self.linear_acceleration[i] = _or_inf(speed.linear_acceleration)
+        self.linear_acceleration[i] = _or_inf(speed.linear_acceleration, self.path_acceleration)
         self.angular_acceleration[i] = _or_inf(speed.angular_acceleration)
 
     def _block(self, block: PathBlock) -> None:
@@ -198,11 +200,13 @@ class _Builder:
         self.zone[rows] = node.zones
         self.linear[rows] = node.speeds
         self.angular[rows] = np.inf if node.angular is None else node.angular
-        self.linear_acceleration[rows] = _or_inf(node.acceleration)
+        self.linear_acceleration[rows] = _or_inf(node.acceleration, self.path_acceleration)
         self.angular_acceleration[rows] = _or_inf(node.angular_acceleration)
 
 
-def _or_inf(value: float | None) -> float:
+def _or_inf(value: float | None, default: float | None = None) -> float:
+    if value is None:
+        value = default
     return np.inf if value is None else value
 
 
