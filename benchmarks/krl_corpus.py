@@ -25,9 +25,12 @@ Besides, it counts statements of the ``.src`` olp read but did not put in the ou
 reported only at ``info`` level (``silent_drops``: "nothing dropped silently" wants 0), and, for
 the files that build, where each statement of the ``.src`` went: ``kept`` (a node of the
 program's IR carries its line, so the KRL post writes it), ``absorbed`` into the motions' speeds,
-zones, tools and bases (inline-form data, BAS, ``$VEL``/``$TOOL``/``$BASE``/``$APO``), an
+zones, tools and bases (inline-form data, BAS, ``$VEL``/``$ACC``/``$TOOL``/``$BASE``/``$APO``/
+``$ORI_TYPE``), an
 ``inlined`` call of the module's own DEF, ``warned`` (reported as not in the output), or
-``unaccounted`` (the figure that must be 0: listed).
+``unaccounted`` (the figure that must be 0: listed). With the KUKA post it also reads the
+written ``.src`` again and compares its statements with the source's, in order
+(``krl_round_trip_differs``: "KRL -> KRL keeps every statement" wants 0).
 
 The last lines are ``name: value unit``.
 """
@@ -53,7 +56,9 @@ _KEYWORD_TEXT = (
     "CONST FRAME E6AXIS E6POS POS AXIS INT REAL BOOL CHAR"
 )
 _KEYWORDS = frozenset(_KEYWORD_TEXT.split())
-POST_KINDS = frozenset({"control_flow", "flow", "verbatim", "unsupported"})
+POST_KINDS = frozenset(
+    {"control_flow", "verbatim", "unsupported", "call_argument", "call_name", "flow"}
+)
 """Errors of a post that cannot write what the program says: not the program's fault."""
 _INSIDE = re.compile(r"inside the (\w+) at line")
 _WORD = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]*")
@@ -74,11 +79,15 @@ class Tally:
     inlined: int = 0
     warned: int = 0
     unaccounted: list[str] = field(default_factory=list)
+    round_trip_differs: list[str] = field(default_factory=list)
 
 
 def construct_of(message: str, source_line: str | None) -> str:
-    """The construct an :class:`~olp.errors.OlpError` stopped on: the block a statement sits in,
-    else the first keyword of the offending line, else the message's first words."""
+    """The construct an :class:`~olp.errors.OlpError` stopped on: ``undeclared name`` (a name
+    that a data list or the controller's $config.dat would declare), else the block a statement
+    sits in, else the first keyword of the offending line, else the message's first words."""
+    if "is not declared" in message:  # a data list or the controller's $config.dat is missing
+        return "undeclared name"
     inside = _INSIDE.search(message)
     if inside:
         return inside.group(1).upper()
@@ -96,8 +105,8 @@ _STRUCTURE = re.compile(
     r"DEFAULT|UNTIL)\b"
 )
 _ABSORBED = re.compile(
-    r"(?i)(BAS\s*\(|(PDAT_ACT|LDAT_ACT|FDAT_ACT)\s*=|\$(VEL|VEL_AXIS|ACC_AXIS|APO|TOOL|BASE|H_POS|"
-    r"IPO_MODE)\b)"
+    r"(?i)(BAS\s*\(|(PDAT_ACT|LDAT_ACT|FDAT_ACT)\s*=|\$(VEL|VEL_AXIS|ACC|ACC_AXIS|APO|TOOL|BASE|"
+    r"H_POS|IPO_MODE|ORI_TYPE|CIRC_TYPE)\b)"
 )
 _ROUTINE = re.compile(r"(?i)(GLOBAL\s+)?(DEF|DEFFCT)\b")
 _CALL = re.compile(r"\s*([A-Za-z_][A-Za-z0-9_]*)\s*\(")
@@ -202,7 +211,41 @@ def _one(olp, path, station, options, post, tally, olp_error) -> str:  # type: i
         return f"program: {errors[0].kind}"
     text = path.read_text(encoding="latin-1")
     account(text, src, result, tally)
+    if post == "kuka" and not round_trips(result, options):
+        tally.round_trip_differs.append(path.name)
+        return "build: KRL -> KRL differs"
     return "build"
+
+
+def shape(program: object) -> list[str]:
+    """The statements and blocks of a program in order, declarations apart (KRL wants them
+    first): motions and other statements by kind, kept lines by their text."""
+    from olp.ir_flow import leaves_and_blocks
+
+    out = []
+    for node in leaves_and_blocks(program.instructions):  # type: ignore[attr-defined]
+        if node.kind == "verbatim":
+            out.append(node.text.upper().replace(" ", ""))
+        elif node.kind != "declare":
+            out.append(node.kind)
+    return out
+
+
+def round_trips(result: object, options: object) -> bool:
+    """KRL -> KRL keeps every statement: the written .src, read again, lowers to the same
+    statements in the same order as the source did."""
+    import tempfile
+
+    from olp.frontends.krl import load_krl
+
+    files = result.files  # type: ignore[attr-defined]
+    with tempfile.TemporaryDirectory() as scratch:
+        for name, text in files.items():
+            (Path(scratch) / name).write_text(text, encoding="latin-1")
+        (written,) = [n for n in files if n.lower().endswith(".src")]
+        config = options.config_dat  # type: ignore[attr-defined]
+        again = load_krl(Path(scratch) / written, config).program
+    return shape(again) == shape(result.compiled.program)  # type: ignore[attr-defined]
 
 
 def main() -> None:
@@ -240,6 +283,9 @@ def main() -> None:
     print(f"statements_inlined_calls: {tally.inlined} statements")
     print(f"statements_warned: {tally.warned} statements")
     print(f"statements_unaccounted: {len(tally.unaccounted)} statements")
+    for name in tally.round_trip_differs:
+        print(f"  KRL -> KRL differs {name}")
+    print(f"krl_round_trip_differs: {len(tally.round_trip_differs)} files")
     print(f"seconds: {seconds:.2f} s")
 
 

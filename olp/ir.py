@@ -35,6 +35,9 @@ from olp.ir_flow import (
 from olp.ir_flow import (
     FLOW_TYPES as FLOW_TYPES,
 )
+from olp.ir_flow import (
+    INTERRUPT_ACTIONS as INTERRUPT_ACTIONS,
+)
 
 # The statements beyond motion and I/O (control flow, data, kept source lines) live in
 # olp.ir_flow and are re-exported here, so that users import every IR node from olp.ir.
@@ -90,6 +93,12 @@ from olp.ir_flow import (
     Index as Index,
 )
 from olp.ir_flow import (
+    InterruptDecl as InterruptDecl,
+)
+from olp.ir_flow import (
+    InterruptSwitch as InterruptSwitch,
+)
+from olp.ir_flow import (
     Label as Label,
 )
 from olp.ir_flow import (
@@ -100,6 +109,9 @@ from olp.ir_flow import (
 )
 from olp.ir_flow import (
     Name as Name,
+)
+from olp.ir_flow import (
+    PathTrigger as PathTrigger,
 )
 from olp.ir_flow import (
     Repeat as Repeat,

@@ -255,6 +255,124 @@ class Return:
 
 
 # --------------------------------------------------------------------------------------------
+# Interrupts and path triggers
+#
+# The KRL these model, as KUKA System Software 8 describes it (Operating and Programming
+# Instructions for System Integrators, "Interrupt programming" and "Path-related switching
+# actions"; the manual itself was not at hand: units and reference points were checked against
+# robot-forum.com thread 34556 "Trigger Questions" and real KR C4 programs):
+#   INTERRUPT DECL Prio WHEN Event DO Subprogram  declares an interrupt whose number is also its
+#     priority (1 highest; 3 is the pendant's standard $STOPMESS interrupt);
+#   INTERRUPT ON|OFF|ENABLE|DISABLE [Prio]  acts on one interrupt, or on all without a number;
+#   TRIGGER WHEN DISTANCE=0|1 DELAY=t DO Statement [PRIO=p]  runs Statement at the start (0) or
+#     the end (1) point of the next motion, shifted by t ms (negative: earlier);
+#   TRIGGER WHEN PATH=d [ONSTART] DELAY=t DO Statement [PRIO=p]  runs it d mm before (d < 0) or
+#     after the end point of the next motion (from its start point with ONSTART).
+# Statement is an assignment or a subprogram call; PRIO only goes with a call.
+
+INTERRUPT_ACTIONS = frozenset({"on", "off", "enable", "disable"})
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class InterruptDecl:
+    """Declare interrupt ``priority``: when ``condition`` becomes true (an edge, not a level),
+    the program stops where it is and runs ``handler`` (a subprogram call), then goes on.
+
+    ``priority`` (an int >= 1) both names the interrupt (:class:`InterruptSwitch` acts on it) and
+    ranks it: a lower number is served first (KRL's convention). ``exported``: the declaration
+    is valid in the routines the program calls too (KRL ``GLOBAL``). A declared interrupt is off
+    until switched on. Passes treat the declaration, and the handler it may run, as taking no
+    time: cycle times do not include interrupts.
+    """
+
+    priority: int
+    condition: Expr
+    handler: FunctionCall
+    exported: bool = False
+    span: SourceSpan = GENERATED
+    kind: Literal["interrupt_decl"] = field(default="interrupt_decl", init=False)
+
+    def __post_init__(self) -> None:
+        if isinstance(self.priority, bool) or not isinstance(self.priority, int):
+            raise FlowError(f"InterruptDecl.priority must be an int, got {self.priority!r}")
+        if self.priority < 1:
+            raise FlowError(f"InterruptDecl.priority must be >= 1, got {self.priority}")
+        if not isinstance(self.handler, FunctionCall):
+            raise FlowError("InterruptDecl.handler must be a FunctionCall (the routine it runs)")
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class InterruptSwitch:
+    """Switch interrupt ``priority`` (None: every declared interrupt) ``on`` or ``off``
+    (declaration kept), or ``disable`` / ``enable`` it (events are held while disabled and
+    served when it is enabled again). Takes no time."""
+
+    action: str
+    priority: int | None = None
+    span: SourceSpan = GENERATED
+    kind: Literal["interrupt"] = field(default="interrupt", init=False)
+
+    def __post_init__(self) -> None:
+        if self.action not in INTERRUPT_ACTIONS:
+            raise FlowError(
+                f"InterruptSwitch.action must be one of {sorted(INTERRUPT_ACTIONS)}, "
+                f"got {self.action!r}"
+            )
+        bad = self.priority is not None and (
+            isinstance(self.priority, bool) or not isinstance(self.priority, int)
+        )
+        if bad or (self.priority is not None and self.priority < 1):
+            raise FlowError(f"InterruptSwitch.priority must be an int >= 1, got {self.priority!r}")
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class PathTrigger:
+    """Run ``action`` at a point of the next motion of the program (the controller attaches a
+    trigger to the motion statement that follows it, whatever stands in between).
+
+    The point is either ``at``: ``"start"`` or ``"end"`` of that motion (KRL ``DISTANCE=0|1``;
+    with approximation the middle of the blend), or ``path`` metres from its end point (KRL
+    ``PATH``; negative: before it; ``from_start``: from its start point instead, KRL
+    ``ONSTART``). ``delay`` (s) shifts the point in time (negative: earlier).
+    ``action`` is an :class:`Assign` or a :class:`FunctionCall` (a subprogram call);
+    ``priority`` is a call's interrupt priority (KRL ``PRIO``; -1: the controller chooses),
+    None for an assignment.
+
+    Passes treat the trigger as taking no time and do not time its action: a cycle time never
+    includes what a trigger starts.
+    """
+
+    action: Assign | FunctionCall
+    at: str | None = None
+    path: float | None = None
+    from_start: bool = False
+    delay: float = 0.0
+    priority: int | None = None
+    span: SourceSpan = GENERATED
+    kind: Literal["trigger"] = field(default="trigger", init=False)
+
+    def __post_init__(self) -> None:
+        if (self.at is None) == (self.path is None):
+            raise FlowError("PathTrigger needs exactly one of at ('start' or 'end') and path (m)")
+        if self.at is not None and self.at not in ("start", "end"):
+            raise FlowError(f"PathTrigger.at must be 'start' or 'end', got {self.at!r}")
+        for name in ("path", "delay"):
+            value = getattr(self, name)
+            if value is not None and not (isinstance(value, int | float) and _finite(value)):
+                raise FlowError(f"PathTrigger.{name} must be a finite number, got {value!r}")
+        if self.from_start and self.path is None:
+            raise FlowError("PathTrigger.from_start is for a path distance")
+        if not isinstance(self.action, Assign | FunctionCall):
+            raise FlowError("PathTrigger.action must be an Assign or a FunctionCall")
+        if self.priority is not None and isinstance(self.action, Assign):
+            raise FlowError("PathTrigger.priority is for a call; an assignment has none")
+
+
+def _finite(value: float) -> bool:
+    return bool(value == value and abs(value) != float("inf"))
+
+
+# --------------------------------------------------------------------------------------------
 # Blocks
 
 
@@ -374,9 +492,33 @@ class For:
 
 
 Block: TypeAlias = If | Switch | While | Repeat | Loop | For
-Statement: TypeAlias = Declare | Assign | WaitUntil | Label | Goto | Exit | Return | Verbatim
+Statement: TypeAlias = (
+    Declare
+    | Assign
+    | WaitUntil
+    | Label
+    | Goto
+    | Exit
+    | Return
+    | InterruptDecl
+    | InterruptSwitch
+    | PathTrigger
+    | Verbatim
+)
 BLOCK_TYPES = (If, Switch, While, Repeat, Loop, For)
-FLOW_TYPES = (*BLOCK_TYPES, Declare, Assign, WaitUntil, Label, Goto, Exit, Return)
+FLOW_TYPES = (
+    *BLOCK_TYPES,
+    Declare,
+    Assign,
+    WaitUntil,
+    Label,
+    Goto,
+    Exit,
+    Return,
+    InterruptDecl,
+    InterruptSwitch,
+    PathTrigger,
+)
 """Nodes of this module that are not ordinary instructions (:class:`Verbatim` is one: passes
 and posts treat it like any other instruction)."""
 

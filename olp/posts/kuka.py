@@ -59,7 +59,7 @@ from olp.errors import PostError
 from olp.ir import ArcOrientation, CartesianTarget
 from olp.ir_flow import FLOW_TYPES, leaves_and_blocks
 from olp.posts.base import Filter, Post
-from olp.posts.kuka_flow import flow_problem, krl_decl, krl_expr
+from olp.posts.kuka_flow import EVENT_KINDS, flow_problem, krl_decl, krl_event, krl_expr
 from olp.posts.numbers import NumberFormat, Storage
 from olp.posts.sandbox import SafeText
 from olp.posts.text import IDENTIFIER, NUMBER, ArgumentRule, NameRule, double_quoted, one_of
@@ -317,6 +317,7 @@ FILTERS: Mapping[str, Filter] = {
     "krl_rows_dat": krl_rows_dat,
     "krl_expr": lambda post, expr: krl_expr(expr),
     "krl_decl": lambda post, step: krl_decl(step),
+    "krl_event": lambda post, node: krl_event(node),
 }
 
 
@@ -328,11 +329,22 @@ class KukaPost(Post):
     LANGUAGE = "KRL"
     VERBATIM = "krl"
     WRITES_FLOW = True
+    KINDS: ClassVar[frozenset[str]] = Post.KINDS | EVENT_KINDS
     NAME_RULE = NAME_RULE
     IO_RANGE = (1, 4096)
     CALL_ARGUMENTS = ArgumentRule(
-        one_of(NUMBER, double_quoted(), IDENTIFIER, "#" + IDENTIFIER, r"\$" + IDENTIFIER),
-        'numbers, "strings", names, #ENUM values, $ variables',
+        one_of(
+            NUMBER,
+            double_quoted(),
+            IDENTIFIER,
+            "#" + IDENTIFIER,
+            r"\$" + IDENTIFIER,
+            # a whole array or an element (P00(#CHK_HOME, #PGNO_GET, DMY[], 0) in every cell.src;
+            # PULSE($OUT[PGNO_REQ], TRUE, 0.2)): names, numbers and commas only inside
+            r"\$?" + IDENTIFIER + r"\[[A-Za-z0-9_$,.+\- ]*\]",
+        ),
+        'numbers, "strings", names, #ENUM values, $ variables, array names and elements '
+        "(NAME[], NAME[1,k])",
     )
     ACCELERATIONS: ClassVar[frozenset[str]] = frozenset(
         {"linear_acceleration", "angular_acceleration"}

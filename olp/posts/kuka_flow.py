@@ -32,6 +32,8 @@ _BINARY = {
 _UNARY = {"not": "NOT ", "bit_not": "B_NOT ", "-": "-", "+": "+"}
 _IDENTIFIER = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]*\Z")
 INT_MIN, INT_MAX = -(2**31), 2**31 - 1
+EVENT_KINDS = frozenset({"interrupt_decl", "interrupt", "trigger"})
+"""Kinds of the interrupt and trigger statements the KUKA post writes (:func:`krl_event`)."""
 """KRL's INT is a 32-bit signed integer."""
 
 
@@ -85,6 +87,36 @@ def krl_decl(step: Any) -> str:
     return f"DECL {prefix}{decl.type_name} {decl.name}{dims}{value}"
 
 
+def krl_event(node: Any) -> str:
+    """An :class:`olp.ir.InterruptDecl`, :class:`olp.ir.InterruptSwitch` or
+    :class:`olp.ir.PathTrigger` as its KRL statement (DELAY in ms, PATH in mm)."""
+    if isinstance(node, ir.InterruptDecl):
+        prefix = "GLOBAL " if node.exported else ""
+        condition, handler = krl_expr(node.condition), krl_expr(node.handler)
+        return f"{prefix}INTERRUPT DECL {node.priority} WHEN {condition} DO {handler}"
+    if isinstance(node, ir.InterruptSwitch):
+        number = "" if node.priority is None else f" {node.priority}"
+        return f"INTERRUPT {node.action.upper()}{number}"
+    assert isinstance(node, ir.PathTrigger)
+    if node.path is not None:
+        where = f"PATH={_plain(node.path * 1000.0)}{' ONSTART' if node.from_start else ''}"
+    else:
+        where = f"DISTANCE={0 if node.at == 'start' else 1}"
+    action = node.action
+    if isinstance(action, ir.Assign):
+        statement = f"{krl_expr(action.target)} = {krl_expr(action.value)}"
+    else:
+        statement = krl_expr(action)
+    prio = "" if node.priority is None else f" PRIO={node.priority}"
+    return f"TRIGGER WHEN {where} DELAY={_plain(node.delay * 1000.0)} DO {statement}{prio}"
+
+
+def _plain(value: float) -> str:
+    """A number without exponent, to 1e-6 of its unit, locale-independent (``-0`` is ``0``)."""
+    text = f"{round(value, 6):.6f}".rstrip("0").rstrip(".")
+    return "0" if text in ("-0", "") else text
+
+
 def flow_problem(node: Any) -> str | None:
     """Why ``node`` (a flow statement or block) cannot be written as KRL, or None."""
     for name in _names(node):
@@ -112,6 +144,11 @@ def _exprs(node: Any) -> list[Any]:
     found = [getattr(node, f, None) for f in fields] + list(getattr(node, "dims", ()))
     found += [b.condition for b in getattr(node, "branches", ())]
     found += [v for c in getattr(node, "cases", ()) for v in c.values]
+    if isinstance(node, ir.InterruptDecl):
+        found.append(node.handler)
+    if isinstance(node, ir.PathTrigger):
+        action = node.action
+        found += [action.target, action.value] if isinstance(action, ir.Assign) else [action]
     return [e for e in found if e is not None]
 
 

@@ -142,3 +142,68 @@ def test_a_copied_post_may_leave_foreign_lines_out_with_a_warning(
     (dropped,) = [d for d in result.diagnostics if d.kind == "verbatim_dropped"]
     assert dropped.severity == "warning" and "'$ADVANCE = 3' (line 12)" in dropped.message
     assert "ADVANCE" not in "".join(result.files.values())
+
+
+def test_an_output_olp_cannot_number_or_value_is_kept_as_written(tmp_path: Path) -> None:
+    """``$OUT[nOut] = bState`` (a PLC handshake with numbers from variables) is a statement of
+    the program: kept for the KRL post, never dropped; a known index and value still make a
+    SetOutput."""
+    path = tmp_path / "io.src"
+    path.write_text(
+        "DEF io( )\nDECL INT nOut\nDECL BOOL bState\nnOut = $IN[7]\nbState = $IN[8]\n"
+        "$OUT[nOut] = TRUE\n$OUT[5] = bState\n$OUT[5] = TRUE\nEND\n"
+    )
+    program = load_krl(path).program
+    kept = [(n.span.line, n.text) for n in program if isinstance(n, ir.Verbatim)]
+    assert kept == [(6, "$OUT[nOut] = TRUE"), (7, "$OUT[5] = bState")]
+    assert [n for n in program if isinstance(n, ir.SetOutput)] == [
+        ir.SetOutput(index=5, value=True, span=ir.SourceSpan(str(path), 8, 1, 8, 15))
+    ]
+
+
+HERE_PROGRAM = (
+    "DEF here( )\nDECL E6POS pAct\npAct = $POS_ACT\n{between}"
+    "SPTP pAct WITH $VEL_AXIS[1]=10, $VEL_AXIS[2]=10\nPTP XHOME\nEND\n"
+)
+
+
+def test_a_motion_to_a_variable_given_pos_act_is_kept_as_no_motion(tmp_path: Path) -> None:
+    """``pAct = $POS_ACT`` then ``SPTP pAct WITH ...``: the restart "to itself" of real cells.
+    With no motion in between it moves to where the robot stands: kept, nothing to check."""
+    path = tmp_path / "here.src"
+    path.write_text(HERE_PROGRAM.format(between=""))
+    program = load_krl(path, CORPUS / "System" / "$config.dat").program
+    kept = [(n.span.line, n.reason) for n in program if isinstance(n, ir.Verbatim)]
+    assert kept == [(4, "moves to where the robot already is (pAct = $POS_ACT): no motion")]
+    assert [n.span.line for n in program.motions()] == [5]
+
+
+@pytest.mark.parametrize(
+    "between",
+    [
+        "PTP XHOME\n",  # the robot moved: pAct is where it was, olp does not know where
+        "IF $IN[3] THEN\nPTP XHOME\nENDIF\n",
+        "GO_SOMEWHERE()\n",  # another module's routine may move it
+    ],
+)
+def test_a_held_pos_act_is_stale_after_anything_that_may_move(tmp_path: Path, between: str) -> None:
+    path = tmp_path / "here.src"
+    path.write_text(HERE_PROGRAM.format(between=between))
+    with pytest.raises(olp.errors.ParseError, match="pAct"):
+        load_krl(path, CORPUS / "System" / "$config.dat")
+
+
+@pytest.mark.parametrize("again", ["$TOOL = $NULLFRAME", "$TOOL = TOOL_DATA[1]"])
+def test_a_tool_set_again_after_a_branch_is_known_even_if_one_path_had_it(
+    tmp_path: Path, again: str
+) -> None:
+    """The inline forms set the tool before every motion; after an IF whose paths leave
+    different tools, setting it again settles it, also to the tool one of the paths had (a
+    real palletizing program stopped here: its next fold set Tool[0] again)."""
+    path = tmp_path / "tools.src"
+    path.write_text(
+        "DEF tools( )\n$TOOL = $NULLFRAME\nIF $IN[1] THEN\n$TOOL = TOOL_DATA[1]\nENDIF\n"
+        f"{again}\nPTP XHOME\nEND\n"
+    )
+    program = load_krl(path, CORPUS / "System" / "$config.dat").program
+    assert [m.span.line for m in program.motions()] == [7]

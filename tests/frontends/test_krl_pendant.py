@@ -575,7 +575,7 @@ def test_signals_from_config(config: KrlData) -> None:
     ("body", "line", "column", "message"),
     [
         (["SPLINE", f"  SPL {FULL}", "ENDSPLINE"], 2, 1, "SPLINE ... ENDSPLINE blocks (lines 2-4)"),
-        ([f"SPTP {FULL} C_DIS"], 2, 1, "C_SPL"),
+        ([f"SPTP {FULL} C_VEL"], 2, 1, "C_SPL"),
         ([f"LIN {FULL} #TOOL"], 2, len(f"LIN {FULL} #"), "only the _REL motions"),
         (["FDAT_ACT = {TOOL_NO 1,IPO_FRAME #TCP}", "BAS(#FRAMES)"], 2, 33, "#TCP"),
         (["BAS(#PTP_PARAMS, 100)"], 2, 1, "FDAT_ACT"),
@@ -635,3 +635,11 @@ def test_one_config_serves_many_programs(config: KrlData) -> None:
     tool = next(untouched.program.motions()).tool
     assert tool.pose is not None
     np.testing.assert_allclose(tool.pose, pose(185.5, 0, 12.5, 0, 90, 0))
+
+
+def test_sptp_approximates_with_c_dis_as_with_c_spl() -> None:
+    """``SPTP X C_DIS`` (written by real KR C4 programs) approximates like ``SPTP X C_SPL``:
+    with the $APO.CDIS distance."""
+    spl = parse("$APO.CDIS = 20", f"SPTP {FULL} C_SPL", f"SPTP {FULL} C_DIS").program
+    zones = [m.zone for m in spl.motions()]
+    assert zones == [ir.Zone(0.02), ir.Zone(0.02)]

@@ -131,3 +131,78 @@ def test_numbers_krl_cannot_hold_are_errors_not_crashes(station: object, tmp_pat
     found = [d for d in result.diagnostics if d.severity == "error"]
     assert [(d.kind, d.span.line if d.span else 0) for d in found] == [("flow", 3), ("flow", 4)]
     assert not result.files
+
+
+def test_interrupts_and_triggers_are_written_back_as_krl(station: object) -> None:
+    """KRL -> KRL keeps each interrupt and trigger as the source has it (DELAY in ms, PATH in
+    mm), in place, a trigger before the motion it belongs to."""
+    result = build(station, CORPUS / "Program" / "trigger_dispense.src")
+    assert result.ok, [d.format() for d in result.diagnostics if d.severity == "error"]
+    lines = result.files["trigger_dispense.src"].replace("\r", "").splitlines()
+    # the INI fold (indented) declares interrupt 3 in every program; these are the source's own
+    events = [line for line in lines if line.startswith(("INTERRUPT", "GLOBAL INTERRUPT", "TRIG"))]
+    assert events == [
+        "GLOBAL INTERRUPT DECL 12 WHEN $IN[31] == FALSE DO PRESSURE_LOST(2, #STOP)",
+        "INTERRUPT DECL 14 WHEN $CYCFLAG[2] == FALSE DO VALVE_FAULT()",
+        "INTERRUPT ON",
+        "INTERRUPT DISABLE 14",
+        "TRIGGER WHEN DISTANCE=0 DELAY=20 DO $OUT[21] = TRUE",
+        "INTERRUPT ENABLE 14",
+        "TRIGGER WHEN PATH=-15.5 DELAY=-40 DO BEAD_LOG(1) PRIO=-1",
+        "TRIGGER WHEN PATH=5 ONSTART DELAY=0 DO $OUT[22] = TRUE",
+        "TRIGGER WHEN DISTANCE=1 DELAY=0 DO $OUT[21] = FALSE",
+        "INTERRUPT OFF 12",
+        "INTERRUPT OFF",
+    ]
+    after = lines[lines.index("TRIGGER WHEN DISTANCE=1 DELAY=0 DO $OUT[21] = FALSE") + 1 :]
+    assert next(line for line in after if line.startswith(("LIN", "PTP"))).startswith("LIN")
+
+
+def event_program() -> ir.Program:
+    at = ir.SourceSpan("t.src", 6, 1)
+    trigger = ir.PathTrigger(action=ir.FunctionCall(name="GLUE_ON"), at="start", span=at)
+    return ir.Program(name="p", instructions=(trigger, down(0.5, 0.1, 7)))
+
+
+@pytest.mark.parametrize("post", ["abb", "ur", "fanuc"])
+def test_other_posts_stop_on_a_trigger_naming_its_line(station: object, post: str) -> None:
+    result = build(station, event_program(), post)
+    errors = [d for d in result.diagnostics if d.severity == "error"]
+    assert errors and all(d.span is not None and d.span.line == 6 for d in errors)
+    assert "trigger" in errors[0].message and not result.files
+
+
+def test_a_post_writing_flow_but_not_events_stops_on_their_line(station: object) -> None:
+    """The base Post's check of instruction kinds covers a post that writes control flow but
+    has not learnt interrupts and triggers: an error on the statement's line."""
+    from olp.posts import find_post
+    from olp.posts.base import Post
+
+    kuka = find_post("kuka")
+    kuka.KINDS = Post.KINDS  # type: ignore[misc]  # this instance only: as if it had not learnt them
+    compiled = olp.compile(event_program(), station, collisions=None)  # type: ignore[arg-type]
+    errors = [d for d in kuka.check(compiled) if d.severity == "error"]
+    assert [(d.kind, d.span.line if d.span else 0) for d in errors] == [("unsupported", 6)]
+    assert "trigger" in errors[0].message
+
+
+@pytest.mark.parametrize(
+    ("args", "ok"),
+    [
+        (("#CHK_HOME", "#PGNO_GET", "DMY[]", "0"), True),  # the controller's own cell.src
+        (("$OUT[PGNO_REQ]", "TRUE", "0.2"), True),
+        (("nPos[1,k]",), True),
+        (("DMY[];LIN {X 0}",), False),
+        (("DMY[1]) ; x",), False),
+        (('DMY["a"]',), False),
+    ],
+)
+def test_the_krl_post_writes_array_arguments_and_nothing_else(
+    station: object, args: tuple[str, ...], ok: bool
+) -> None:
+    call = ir.Call(name="P00", args=args, span=ir.SourceSpan("t.src", 3, 1))
+    result = build(station, ir.Program(name="p", instructions=(call,)))
+    errors = [d.kind for d in result.diagnostics if d.severity == "error"]
+    assert errors == ([] if ok else ["call_argument"])
+    if ok:
+        assert f"P00({', '.join(args)})" in result.files["p.src"]

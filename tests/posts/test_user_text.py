@@ -170,7 +170,8 @@ def test_calls_that_could_start_a_statement_are_errors(
     ("post", "call", "line"),
     [
         ("kuka", ir.Call(name="BAS", args=("#PTP_PARAMS", "100")), "BAS(#PTP_PARAMS, 100)"),
-        ("kuka", ir.Call(name="Grip", args=('"open"', "$OUT[3]")), None),
+        ("kuka", ir.Call(name="Grip", args=('"open"', "$OUT[3]")), 'Grip("open", $OUT[3])'),
+        ("kuka", ir.Call(name="Grip", args=('"open"', "$OUT[3]+1")), None),
         ("abb", ir.Call(name="Grip", args=("1", '"open"', "TRUE")), 'Grip 1, "open", TRUE;'),
         ("ur", ir.Call(name="grip", args=("1.5e3", '"x"')), 'grip(1.5e3, "x")'),
         ("fanuc", ir.Call(name="grip", args=("-1", "2.5")), "CALL GRIP(-1,2.5) ;"),
@@ -182,7 +183,7 @@ def test_literal_arguments_are_written(
     station = stations[post]
     result = _build(station, [_home_move(station), call], post)
     if post == "kuka" and line is None:
-        assert _errors(result) == [("call_argument", 1)]  # $OUT[3] is an expression
+        assert _errors(result) == [("call_argument", 1)]  # $OUT[3]+1 is an expression
         return
     assert result.ok, [d.format() for d in result.diagnostics]
     assert line in "\n".join(result.files.values())

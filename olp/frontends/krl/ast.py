@@ -341,6 +341,39 @@ class Other:
     name: str | None = None  # a label's or a GOTO's label name
 
 
+@dataclass(frozen=True, slots=True)
+class InterruptDecl:
+    """``[GLOBAL] INTERRUPT DECL prio WHEN condition DO handler(args)``."""
+
+    exported: bool
+    priority: Expr
+    condition: Expr
+    action: CallStmt | Assign
+    span: ir.SourceSpan
+
+
+@dataclass(frozen=True, slots=True)
+class InterruptCtl:
+    """``INTERRUPT ON|OFF|ENABLE|DISABLE [prio]``."""
+
+    action: str
+    priority: Expr | None
+    span: ir.SourceSpan
+
+
+@dataclass(frozen=True, slots=True)
+class Trigger:
+    """``TRIGGER WHEN DISTANCE|PATH=value [ONSTART] DELAY=t DO action [PRIO=p]``."""
+
+    mode: str  # "DISTANCE" or "PATH"
+    position: Expr
+    onstart: bool
+    delay: Expr
+    action: CallStmt | Assign
+    priority: Expr | None
+    span: ir.SourceSpan
+
+
 Stmt: TypeAlias = (
     Assign
     | CallStmt
@@ -352,6 +385,9 @@ Stmt: TypeAlias = (
     | SignalDecl
     | ForLoop
     | Block
+    | InterruptDecl
+    | InterruptCtl
+    | Trigger
     | Other
 )
 

@@ -28,6 +28,8 @@ from olp.frontends.krl.ast import (
     ForLoop,
     IgnoredLine,
     Index,
+    InterruptCtl,
+    InterruptDecl,
     Module,
     MotionStmt,
     Other,
@@ -35,12 +37,14 @@ from olp.frontends.krl.ast import (
     SignalDecl,
     SourceSet,
     Stmt,
+    Trigger,
     Unary,
     Var,
     WaitFor,
     WaitSec,
 )
 from olp.frontends.krl.data import OTHER_REASONS, KrlData
+from olp.frontends.krl.events import Events
 from olp.frontends.krl.flow import assigned_names, is_straight, jump_targets, statements, to_expr
 from olp.frontends.krl.motion import Motions
 from olp.frontends.krl.state import (
@@ -49,6 +53,7 @@ from olp.frontends.krl.state import (
     KrlResult,
     State,
     build_instructions,
+    is_here,
 )
 from olp.frontends.krl.values import (
     Bool,
@@ -69,14 +74,6 @@ MAX_FOR_ITERATIONS = 1_000_000
 MAX_LOWERED_STATEMENTS = 2_000_000
 """Statements (and loop iterations) lowered in one run, counting every unrolled and inlined copy:
 bounds the time and memory a small file can ask for through nested loops."""
-_HERE = frozenset({"$POS_ACT", "$AXIS_ACT", "$POS_ACT_MES", "$AXIS_ACT_MES"})
-"""Targets that are where the robot stands when the motion starts."""
-
-
-def _is_here(var: Var) -> bool:
-    return not var.selectors and var.name.upper() in _HERE
-
-
 _KEPT_OTHERS = frozenset({"RESUME", "ON_ERROR_PROCEED", "HALT", "BRAKE", "CONTINUE"})
 """Statements that change how the controller runs the program: kept as written."""
 _IGNORED_CALLS = {
@@ -123,7 +120,7 @@ class RoutineJumps:
         return cls(labels, jump_targets(body), assigned_names(body))
 
 
-class _Lowering(Motions):
+class _Lowering(Motions, Events):
     """Walks statements (inlining calls, unrolling constant FOR loops over straight-line code,
     lowering blocks to :mod:`olp.ir_flow` blocks), appending IR.
 
@@ -157,6 +154,9 @@ class _Lowering(Motions):
             SignalDecl: self._signal,
             ForLoop: self._for,
             Block: self._block,
+            InterruptDecl: self._interrupt_decl,
+            InterruptCtl: self._interrupt_ctl,
+            Trigger: self._trigger,
             Other: self._other,
         }
 
@@ -206,13 +206,32 @@ class _Lowering(Motions):
     # ---- motions to where the robot is
     def _motion_or_here(self, stmt: MotionStmt) -> None:
         """``PTP $POS_ACT`` / ``PTP $AXIS_ACT`` (the block coincidence run of a program start)
-        move to where the robot already is: nothing to check, kept as written."""
+        move to where the robot already is: nothing to check, kept as written. So does a motion
+        to a variable that was given ``$POS_ACT`` with no motion since (``pAct = $POS_ACT`` /
+        ``SPTP pAct WITH $VEL_AXIS[1] = 10, ...``): a WITH clause only sets that motion's own
+        speeds and accelerations."""
         target = stmt.targets[-1] if stmt.targets else None
         simple = stmt.keyword in ("PTP", "SPTP", "LIN", "SLIN") and not stmt.with_clause
-        if simple and isinstance(target, Var) and _is_here(target):
+        if simple and isinstance(target, Var) and is_here(target):
             self._keep(stmt, f"moves to where the robot already is ({target.name}): no motion")
-        else:
-            self._motion(stmt)
+            return
+        held = self._holds_here(target)
+        if stmt.keyword in ("PTP", "SPTP", "LIN", "SLIN") and held is not None:
+            assert isinstance(target, Var)
+            reason = f"moves to where the robot already is ({target.name} = {held}): no motion"
+            self._keep(stmt, reason)
+            return
+        self._motion(stmt)
+
+    def _holds_here(self, target: object) -> str | None:
+        """The controller variable (``$POS_ACT``) a plain variable was given, if no motion was
+        lowered since, else None."""
+        if not isinstance(target, Var) or target.selectors:
+            return None
+        found = self.here_vars.get(target.name.upper())
+        if found is None or found[1] != self.motion_count:
+            return None
+        return found[0]
 
     # ---- declarations
     def _decl(self, stmt: Decl) -> None:
@@ -248,6 +267,7 @@ class _Lowering(Motions):
         elif name in _IGNORED_CALLS:
             self._keep(stmt, _IGNORED_CALLS[name])
         else:
+            self.motion_count += 1  # another module's routine may move the robot
             args = tuple("" if arg is None else self.sources.snippet(arg.span) for arg in stmt.args)
             self.out.append(ir.Call(name=stmt.name, args=args, span=stmt.span))
 
@@ -359,6 +379,7 @@ class _Lowering(Motions):
     def _for(self, stmt: ForLoop) -> None:
         """Unrolled when its bounds are constant and its body is straight-line code; otherwise
         lowered as an :class:`olp.ir.For` block (its counter unknown inside)."""
+        self.motion_count += 1  # the loop may move the robot
         parts = [stmt.start, stmt.end] + ([stmt.step] if stmt.step is not None else [])
         numbers = [as_int(self._value(part)) for part in parts]
         if any(n is None for n in numbers) or not is_straight(stmt.body):
@@ -442,6 +463,7 @@ class _Lowering(Motions):
                 stmt.span,
                 hint="olp lowers single SPTP, SLIN and SCIRC motions; write the segments as those",
             )
+        self.motion_count += 1  # a block may move the robot: a held $POS_ACT is stale after it
         self._blocks[stmt.keyword](stmt)
 
     def _if(self, stmt: Block) -> None:
@@ -728,6 +750,12 @@ def lower_module(
         if other.name.upper() not in ctx.called:
             what = "is never called" if other.kind == "DEF" else "is a function (not lowered)"
             reason = f"{other.kind} {other.name} {what}"
+            runs_as = ctx.handlers.get(other.name.upper())
+            if runs_as is not None:
+                reason = (
+                    f"DEF {other.name} runs from the {runs_as}; olp does not write routines, so "
+                    "the written program calls a routine it does not hold"
+                )
             lowering.ignored.append(IgnoredLine(other.span, sources.snippet(other.span), reason))
     ignored = sorted(lowering.ignored, key=lambda i: (i.span.line, i.span.column))
     for data_list in (dat, config):

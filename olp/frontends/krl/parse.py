@@ -50,6 +50,8 @@ from olp.frontends.krl.ast import (
     ForLoop,
     FuncCall,
     Index,
+    InterruptCtl,
+    InterruptDecl,
     Member,
     Module,
     MotionStmt,
@@ -61,6 +63,7 @@ from olp.frontends.krl.ast import (
     Source,
     Stmt,
     Text,
+    Trigger,
     Unary,
     Var,
     WaitFor,
@@ -80,9 +83,6 @@ _OTHER_KINDS = {
     "ext_decl": "EXT",
     "struc_decl": "STRUC",
     "enum_decl": "ENUM",
-    "interrupt_decl": "INTERRUPT DECL",
-    "interrupt_ctl": "INTERRUPT",
-    "trigger": "TRIGGER",
     "goto_stmt": "GOTO",
     "label": "label",
     "return_stmt": "RETURN",
@@ -244,6 +244,22 @@ class _ToAst(Transformer[Token, Module]):
     @_inline
     def call_stmt(self, meta: Meta, name: Token, args: tuple[Expr | None, ...]) -> CallStmt:
         return CallStmt(str(name), args, self._span(meta))
+
+    @_inline
+    def interrupt_decl(
+        self, meta: Meta, glob: Token | None, prio: Expr, cond: Expr, action: CallStmt | Assign
+    ) -> InterruptDecl:
+        return InterruptDecl(glob is not None, prio, cond, action, self._span(meta))
+
+    @_inline
+    def interrupt_ctl(self, meta: Meta, action: Token, prio: Expr | None) -> InterruptCtl:
+        return InterruptCtl(str(action).upper(), prio, self._span(meta))
+
+    @_inline
+    def trigger(self, meta: Meta, mode: Token, position: Expr, *rest: Any) -> Trigger:
+        onstart, delay, action, prio = rest
+        span = self._span(meta)
+        return Trigger(str(mode).upper(), position, onstart is not None, delay, action, prio, span)
 
     @_inline
     def motion(self, meta: Meta, keyword: Token, *rest: Any) -> MotionStmt:

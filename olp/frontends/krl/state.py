@@ -238,6 +238,7 @@ class Context:
         self.sources = sources
         self.routines = routines
         self.called: set[str] = set()
+        self.handlers: dict[str, str] = {}  # routine -> "the interrupt at line 12" (never inlined)
         self.main = next(iter(routines), "")
         self.budget = self.remaining = budget
         self.config = config
@@ -294,6 +295,15 @@ def data_file_name(data: KrlData) -> str:
 # The core of a lowering
 
 
+HERE = frozenset({"$POS_ACT", "$AXIS_ACT", "$POS_ACT_MES", "$AXIS_ACT_MES"})
+"""Targets that are where the robot stands when the motion starts."""
+
+
+def is_here(expr: object) -> bool:
+    """Whether ``expr`` is one of :data:`HERE`."""
+    return isinstance(expr, Var) and not expr.selectors and expr.name.upper() in HERE
+
+
 class Core:
     """State, variables, reports, values and system-variable assignments of one lowering."""
 
@@ -315,6 +325,8 @@ class Core:
         self.exiting: int | None = None  # line of an EXIT leaving the current loop
         self._after_with: int | None = None  # line of the last motion whose WITH set anything
         self._reported: set[tuple[Any, ...]] = set()
+        self.motion_count = 0  # motions lowered so far (by this lowering)
+        self.here_vars: dict[str, tuple[str, int]] = {}  # name -> ($POS_ACT..., motion_count)
         self._setters: dict[str, Callable[[str, Expr, Stmt], None]] = {
             "$VEL.CP": self._set_vel_cp,
             "$ACC.CP": self._set_acc_cp,
@@ -425,6 +437,12 @@ class Core:
         elif self._is_signal(stmt.target):
             self._signal_output(stmt)
         else:
+            name = stmt.target.name.upper()
+            if is_here(stmt.value) and not stmt.target.selectors:
+                assert isinstance(stmt.value, Var)
+                self.here_vars[name] = (stmt.value.name.upper(), self.motion_count)
+            else:
+                self.here_vars.pop(name, None)
             self.data.assign(stmt)  # what olp knows of the value afterwards
             if stmt.target.name.upper() not in INLINE_FORM_DATA:
                 self.out.append(self._assignment(stmt))
@@ -513,13 +531,23 @@ class Core:
         self._set_axes_percent(name, dict.fromkeys(range(1, len(AXES) + 1), percent))
 
     def _set_output(self, key: str, value: Expr, stmt: Stmt) -> None:
+        """``$OUT[n] = value``: a :class:`~olp.ir.SetOutput` when ``n`` and the value are known
+        (``$OUT[PGNO_REQ] = FALSE``, the index a variable of $config.dat); otherwise kept as
+        written (``$OUT[nOut] = bState``): the KUKA post writes it back, others stop on it."""
         assert isinstance(stmt, Assign)
+        selector = stmt.target.selectors[0]
+        if isinstance(selector, Index) and len(selector.args) == 1 and selector.args[0] is not None:
+            number = self._value(selector.args[0])
+            if as_number(number) is None:  # a constant but wrong index stays an error below
+                why = number.reason if isinstance(number, Unknown) else "not a number"
+                self._keep(stmt, f"an output olp cannot number ({why})")
+                return
         self._output(self._single_index(stmt.target, "$OUT"), value, stmt)
 
     def _output(self, index: int, value: Expr, stmt: Assign) -> None:
         constant = self._value(value)
         if not isinstance(constant, Bool):
-            self._ignore(stmt, "only constant TRUE/FALSE outputs are lowered")
+            self._keep(stmt, "an output set to a value olp does not know (not TRUE or FALSE)")
             return
         self.out.append(ir.SetOutput(index=index, value=constant.value, span=stmt.span))
 
@@ -581,10 +609,19 @@ class Core:
     def _change_frame(self, frame: ir.Frame, stmt: Stmt | Assign) -> None:
         if frame != self.state.frame:
             self._reset_start(dataclasses.replace(self.state, frame=frame), "$BASE", stmt.span)
+        self._settled("frame")
 
     def _change_tool(self, tool: ir.Tool, stmt: Stmt | Assign) -> None:
         if tool != self.state.tool:
             self._reset_start(dataclasses.replace(self.state, tool=tool), "$TOOL", stmt.span)
+        self._settled("tool")
+
+    def _settled(self, name: str) -> None:
+        """A setting the program has just set is known, whatever the paths before it set (the
+        value may equal the one the state holds after a join: then nothing else changes)."""
+        ambiguous: dict[str, str] | None = getattr(self, "ambiguous", None)
+        if ambiguous:
+            ambiguous.pop(name, None)
 
     def _reset_start(self, state: State, name: str, span: ir.SourceSpan) -> None:
         self.state = state
