@@ -399,7 +399,9 @@ class Post:
         if kind == "verbatim":
             return self._verbatim_checks(step, ins)
         if kind not in self.KINDS:
-            msg = f"the {self.LANGUAGE} post cannot write a {kind.replace('_', ' ')} instruction"
+            what = kind.replace("_", " ")
+            article = "an" if what[:1] in "aeiou" else "a"
+            msg = f"the {self.LANGUAGE} post cannot write {article} {what} instruction"
             return [_error("unsupported", msg, step)]
         if kind == "comment":
             return self._comment_checks(step, ins.text)

@@ -206,3 +206,11 @@ def test_the_krl_post_writes_array_arguments_and_nothing_else(
     assert errors == ([] if ok else ["call_argument"])
     if ok:
         assert f"P00({', '.join(args)})" in result.files["p.src"]
+
+
+def test_the_error_names_an_interrupt_with_its_article(station: object) -> None:
+    at = ir.SourceSpan("t.src", 4, 1)
+    switch = ir.InterruptSwitch(action="on", priority=5, span=at)
+    program = ir.Program(name="p", instructions=(switch, down(0.5, 0.1, 7)))
+    errors = [d for d in build(station, program, "abb").diagnostics if d.severity == "error"]
+    assert "cannot write an interrupt instruction" in errors[0].message
