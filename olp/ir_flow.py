@@ -582,3 +582,27 @@ def map_leaves(nodes: Sequence[Any], edit: Callable[[Any], list[Any]]) -> tuple[
         else:
             out.extend(edit(node))
     return tuple(out)
+
+
+def sub_expressions(expr: Any) -> list[Any]:
+    """The expressions directly inside ``expr`` (operands, index, base, arguments, members)."""
+    if isinstance(expr, BinaryOp):
+        return [expr.left, expr.right]
+    if isinstance(expr, UnaryOp):
+        return [expr.operand]
+    if isinstance(expr, Index):
+        return [expr.base, *(i for i in expr.indices if i is not None)]
+    if isinstance(expr, Member):
+        return [expr.base]
+    if isinstance(expr, FunctionCall):
+        return [a for a in expr.args if a is not None]
+    if isinstance(expr, Aggregate):
+        return [v for _, v in expr.members]
+    return []
+
+
+def walk_expression(expr: Any) -> Iterator[Any]:
+    """``expr`` and every expression inside it, depth first."""
+    yield expr
+    for child in sub_expressions(expr):
+        yield from walk_expression(child)

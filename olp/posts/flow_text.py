@@ -32,6 +32,7 @@ from typing import Any, ClassVar
 from olp import ir
 from olp.diagnostics import Diagnostic
 from olp.ir_flow import BLOCK_TYPES, FLOW_TYPES, bodies, leaves_and_blocks
+from olp.ir_flow import walk_expression as walk
 from olp.posts.sandbox import SafeText
 
 
@@ -213,29 +214,6 @@ def exprs_of(node: Any) -> list[Any]:
     return [e for e in found if e is not None]
 
 
-def children(expr: Any) -> list[Any]:
-    if isinstance(expr, ir.BinaryOp):
-        return [expr.left, expr.right]
-    if isinstance(expr, ir.UnaryOp):
-        return [expr.operand]
-    if isinstance(expr, ir.Index):
-        return [expr.base, *(i for i in expr.indices if i is not None)]
-    if isinstance(expr, ir.Member):
-        return [expr.base]
-    if isinstance(expr, ir.FunctionCall):
-        return [a for a in expr.args if a is not None]
-    if isinstance(expr, ir.Aggregate):
-        return [v for _, v in expr.members]
-    return []
-
-
-def walk(expr: Any) -> Iterator[Any]:
-    """``expr`` and every expression inside it."""
-    yield expr
-    for child in children(expr):
-        yield from walk(child)
-
-
 def root_name(expr: Any) -> str | None:
     """The variable an assignment target writes (``a`` of ``a[1].x``)."""
     while isinstance(expr, ir.Index | ir.Member):
@@ -337,6 +315,8 @@ class FlowWriter:
     LANGUAGE: ClassVar[str] = ""
     BASE_INDENT: ClassVar[int] = 0
     STEP: ClassVar[int] = 2
+    NOT: ClassVar[str] = "NOT "
+    """The logical negation, with the space after it."""
 
     def __init__(self, symbols: Symbols, taken: Iterable[str] = ()) -> None:
         self.symbols = symbols
@@ -344,6 +324,23 @@ class FlowWriter:
         self.stack: list[OpenBlock] = []
         self.helpers: list[tuple[str, str]] = []
         """Generated helper variables (name, kind) a file must declare."""
+
+    # ---- expressions (the spelling of each language's subclass)
+
+    def expr(self, expr: ir.Expr | None, nested: bool = False) -> str:
+        """``expr`` in this language; a :class:`FlowProblem` where it cannot be said exactly."""
+        raise NotImplementedError
+
+    def unary(self, expr: ir.UnaryOp) -> str:
+        """``not``, ``-`` and ``+``; bit operations have no counterpart olp writes."""
+        operand = self.expr(expr.operand, nested=True)
+        if expr.op == "not":
+            return f"{self.NOT}{operand}"
+        if expr.op == "-":
+            return f"-{operand}"
+        if expr.op == "+":
+            return operand
+        raise FlowProblem(f"bit operations have no {self.LANGUAGE} counterpart olp writes")
 
     # ---- the template's side
 

@@ -19,6 +19,7 @@ import re
 from typing import Any
 
 from olp import ir
+from olp.ir_flow import sub_expressions
 
 _BINARY = {
     "and": "AND",
@@ -163,7 +164,7 @@ def _expr_problem(expr: Any) -> str | None:
         bad = [n for n, _ in expr.members if not _IDENTIFIER.match(n)]
         if bad or (expr.type_name and not _IDENTIFIER.match(expr.type_name)):
             return f"the structure value {krl_expr(expr)!r} has a member that is not a KRL name"
-    for child in _children(expr):
+    for child in sub_expressions(expr):
         problem = _expr_problem(child)
         if problem is not None:
             return problem
@@ -186,19 +187,3 @@ def _constant_problem(expr: ir.Constant) -> str | None:
 
 def _has_control(text: str) -> bool:
     return any(ord(c) < 32 or 127 <= ord(c) < 160 for c in text)
-
-
-def _children(expr: Any) -> list[Any]:
-    if isinstance(expr, ir.BinaryOp):
-        return [expr.left, expr.right]
-    if isinstance(expr, ir.UnaryOp):
-        return [expr.operand]
-    if isinstance(expr, ir.Index):
-        return [expr.base, *(i for i in expr.indices if i is not None)]
-    if isinstance(expr, ir.Member):
-        return [expr.base]
-    if isinstance(expr, ir.FunctionCall):
-        return [a for a in expr.args if a is not None]
-    if isinstance(expr, ir.Aggregate):
-        return [v for _, v in expr.members]
-    return []

@@ -292,16 +292,6 @@ class RapidWriter(FlowWriter):
             raise FlowProblem(f"the input signal name {name!r} is not a RAPID name")
         return name
 
-    def unary(self, expr: ir.UnaryOp) -> str:
-        operand = self.expr(expr.operand, nested=True)
-        if expr.op == "not":
-            return f"NOT {operand}"
-        if expr.op == "-":
-            return f"-{operand}"
-        if expr.op == "+":
-            return operand
-        raise FlowProblem("bit operations have no RAPID counterpart for num")
-
     def binary(self, expr: ir.BinaryOp) -> str:
         op = _BINARY.get(expr.op, expr.op if expr.op in _ARITHMETIC else None)
         if op is None:

@@ -106,6 +106,7 @@ class UrWriter(FlowWriter):
 
     LANGUAGE: ClassVar[str] = "URScript"
     BASE_INDENT: ClassVar[int] = 2
+    NOT: ClassVar[str] = "not "
 
     def __init__(self, symbols: Symbols, rule: NameRule, taken: Iterable[str] = ()) -> None:
         super().__init__(symbols, taken)
@@ -233,16 +234,6 @@ class UrWriter(FlowWriter):
                 raise FlowProblem(f"the index {value} is below KRL's first element, 1")
             return str(value - 1)
         return f"{self.expr(index, nested=True)} - 1"
-
-    def unary(self, expr: ir.UnaryOp) -> str:
-        operand = self.expr(expr.operand, nested=True)
-        if expr.op == "not":
-            return f"not {operand}"
-        if expr.op == "-":
-            return f"-{operand}"
-        if expr.op == "+":
-            return operand
-        raise FlowProblem("bit operations have no URScript counterpart olp writes")
 
     def binary(self, expr: ir.BinaryOp) -> str:
         op = _BINARY.get(expr.op, expr.op if expr.op in _PLAIN else None)
