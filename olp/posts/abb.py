@@ -67,7 +67,14 @@ from olp.diagnostics import Diagnostic
 from olp.errors import PostError
 from olp.ir_flow import leaves_and_blocks
 from olp.posts.base import Filter, Post
-from olp.posts.flow_text import FLOW_STEP_KINDS, Symbols, flow_problems, jump_problems
+from olp.posts.flow_text import (
+    FLOW_STEP_KINDS,
+    Symbols,
+    flow_lines_filter,
+    flow_pad_filter,
+    flow_problems,
+    jump_problems,
+)
 from olp.posts.numbers import NumberFormat, Storage
 from olp.posts.rapid_flow import RapidWriter, counter_problems
 from olp.posts.sandbox import SafeText
@@ -308,24 +315,10 @@ def _confdata_filter(post: Post, joints: ArrayLike, robot: Any) -> str:
     return rapid_confdata(confdata(robot, joints))
 
 
-def _flow_filter(post: Post, step: PostStep) -> SafeText:
-    """Template filter: ``s | rapid_flow``, the lines of a marker or flow statement
-    (:class:`olp.posts.rapid_flow.RapidWriter`), indented."""
-    assert isinstance(post, AbbPost) and post.flow is not None
-    return post.flow.lines(step)
-
-
-def _pad_filter(post: Post, step: Any) -> int:
-    """Template filter: ``s | rapid_pad``, the extra indentation of an ordinary statement inside
-    blocks (0 outside any)."""
-    flow = getattr(post, "flow", None)
-    return 0 if flow is None else int(flow.pad())
-
-
 FILTERS: Mapping[str, Filter] = {
     **Post.FILTERS,
-    "rapid_flow": _flow_filter,
-    "rapid_pad": _pad_filter,
+    "rapid_flow": flow_lines_filter,
+    "rapid_pad": flow_pad_filter,
     "rapid_pose": rapid_pose,
     "rapid_robtarget": _robtarget_filter,
     "rapid_jointtarget": rapid_jointtarget,

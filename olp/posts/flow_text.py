@@ -419,3 +419,18 @@ def flow_problems(
         )
         for node, problem in found
     ]
+
+
+def flow_lines_filter(post: Any, step: Any) -> SafeText:
+    """Template filter (``s | rapid_flow``, ``s | ur_flow``): the lines of a marker or flow
+    statement, indented, by the post's writer of the file being rendered (``post.flow``)."""
+    flow = getattr(post, "flow", None)
+    assert isinstance(flow, FlowWriter), "a flow step outside a file with control flow"
+    return flow.lines(step)
+
+
+def flow_pad_filter(post: Any, step: Any) -> int:
+    """Template filter (``s | rapid_pad``, ``s | ur_pad``): the extra indentation of an
+    ordinary statement inside blocks (0 outside any, or in a file without control flow)."""
+    flow = getattr(post, "flow", None)
+    return 0 if flow is None else int(flow.pad())

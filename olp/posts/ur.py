@@ -78,7 +78,13 @@ from olp.diagnostics import Diagnostic
 from olp.ir import ArcOrientation
 from olp.ir_flow import bodies
 from olp.posts.base import Filter, Post
-from olp.posts.flow_text import FLOW_STEP_KINDS, Symbols, flow_problems
+from olp.posts.flow_text import (
+    FLOW_STEP_KINDS,
+    Symbols,
+    flow_lines_filter,
+    flow_pad_filter,
+    flow_problems,
+)
 from olp.posts.numbers import NumberFormat
 from olp.posts.sandbox import SafeText
 from olp.posts.text import NUMBER, ArgumentRule, CommentRule, NameRule
@@ -239,24 +245,10 @@ def _blends_filter(post: Post, steps: Any, station: Any) -> dict[int, float]:
     return {c.index: c.radius for c in blend_radii(list(steps), robot, robot.home)}
 
 
-def _flow_filter(post: Post, step: PostStep) -> SafeText:
-    """Template filter: ``s | ur_flow``, the lines of a marker or flow statement
-    (:class:`olp.posts.ur_flow.UrWriter`), indented ('' for a marker that writes nothing)."""
-    assert isinstance(post, UrPost) and post.flow is not None
-    return post.flow.lines(step)
-
-
-def _pad_filter(post: Post, step: Any) -> int:
-    """Template filter: ``s | ur_pad``, the extra indentation of an ordinary statement inside
-    blocks (0 outside any)."""
-    flow = getattr(post, "flow", None)
-    return 0 if flow is None else int(flow.pad())
-
-
 FILTERS: Mapping[str, Filter] = {
     **Post.FILTERS,
-    "ur_flow": _flow_filter,
-    "ur_pad": _pad_filter,
+    "ur_flow": flow_lines_filter,
+    "ur_pad": flow_pad_filter,
     "ur_pose": ur_pose,
     "ur_joints": ur_joints,
     "ur_via": _via_filter,
