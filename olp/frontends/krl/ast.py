@@ -287,11 +287,12 @@ class DeclItem:
 
 @dataclass(frozen=True, slots=True)
 class Decl:
-    """``DECL [GLOBAL] [CONST] TYPE name[dims] [= value], ...``"""
+    """``DECL [GLOBAL] [CONST] TYPE name[dims] [= value], ...`` (``is_global``: GLOBAL given)"""
 
     type_name: str
     items: tuple[DeclItem, ...]
     span: ir.SourceSpan
+    is_global: bool = False
 
 
 @dataclass(frozen=True, slots=True)
@@ -410,9 +411,12 @@ class Routine:
 
 @dataclass(frozen=True, slots=True)
 class DatBlock:
+    """``DEFDAT name [PUBLIC]`` ... ``ENDDAT``."""
+
     name: str
     body: tuple[Stmt, ...]
     span: ir.SourceSpan
+    public: bool = False
 
 
 @dataclass(frozen=True, slots=True)
