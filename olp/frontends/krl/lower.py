@@ -27,7 +27,6 @@ from olp.frontends.krl.ast import (
     FastMotion,
     ForLoop,
     IgnoredLine,
-    Index,
     InterruptCtl,
     InterruptDecl,
     Module,
@@ -591,18 +590,6 @@ class _Lowering(Motions, Events):
         converted = to_expr(expr, self._input_index)
         assert converted is not None
         return converted
-
-    def _input_index(self, var: Var) -> int | None:
-        if var.key == "$IN[]":
-            index = var.selectors[0]
-            assert isinstance(index, Index)
-            arg = index.args[0] if len(index.args) == 1 else None
-            return None if arg is None else as_int(self._value(arg))
-        if not var.selectors:
-            signal = self._value(var)
-            if isinstance(signal, Signal) and signal.io == "$IN":
-                return signal.index
-        return None
 
     # ---- jumps
     def _goto(self, stmt: Other) -> None:

@@ -365,9 +365,24 @@ class Core:
         """``stmt`` as IR: a statement of the program, kept whatever olp knows of its value."""
         from olp.frontends.krl.flow import to_expr
 
-        target, value = (to_expr(e, lambda _: None) for e in (stmt.target, stmt.value))
+        target = to_expr(stmt.target, lambda _: None)
+        value = to_expr(stmt.value, self._input_index)
         assert target is not None and value is not None
         return ir.Assign(target=target, value=value, span=stmt.span)
+
+    def _input_index(self, var: Var) -> int | None:
+        """The input number of ``$IN[n]`` (a constant ``n``) or of a one-bit SIGNAL of an
+        input: read as :class:`~olp.ir.DigitalInput` wherever an expression is."""
+        if var.key == "$IN[]":
+            index = var.selectors[0]
+            assert isinstance(index, Index)
+            arg = index.args[0] if len(index.args) == 1 else None
+            return None if arg is None else as_int(self._value(arg))
+        if not var.selectors:
+            signal = self._value(var)
+            if isinstance(signal, Signal) and signal.io == "$IN":
+                return signal.index
+        return None
 
     def _keep(self, stmt: Stmt | Assign, reason: str) -> None:
         """Keep a statement olp does not model as :class:`~olp.ir.Verbatim` (its text without
