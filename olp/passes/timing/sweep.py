@@ -14,6 +14,7 @@ from olp.ir import CircularMove, JointMove, LinearMove
 from olp.passes.timing.plan import TimingOptions, time_table
 from olp.passes.timing.program import Times, time_fixed, time_joints, time_paths
 from olp.passes.timing.table import JOINT, MotionTable, plan, travel
+from olp.transforms.blend import with_step_instructions
 
 FloatArray = NDArray[np.float64]
 
@@ -23,7 +24,10 @@ def override_speeds(
 ) -> CompiledProgram:
     """A copy in which every path move runs at ``linear`` m/s and every joint move at ``joint``
     (fraction of the axes' maximum velocity); ``None`` keeps the programmed value. Acceleration
-    and orientation-speed settings stay as programmed."""
+    and orientation-speed settings stay as programmed. A program with control flow keeps its
+    blocks (:func:`~olp.transforms.blend.with_step_instructions`), so each path is timed as the
+    program runs it."""
+
     steps = []
     for step in compiled.steps:
         ins = step.instruction
@@ -32,7 +36,7 @@ def override_speeds(
         elif isinstance(ins, JointMove) and joint is not None:
             ins = dataclasses.replace(ins, speed=dataclasses.replace(ins.speed, joint=joint))
         steps.append(dataclasses.replace(step, instruction=ins))
-    program = compiled.program.replace_instructions([s.instruction for s in steps])
+    program = with_step_instructions(compiled.program, [s.instruction for s in steps])
     return dataclasses.replace(compiled, program=program, steps=tuple(steps))
 
 
