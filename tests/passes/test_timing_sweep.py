@@ -13,7 +13,7 @@ import olp
 from olp import ir
 from olp.ir_flow import leaves_and_blocks
 from olp.passes.pipeline import BuildOptions
-from olp.passes.timing import override_speeds, time_program
+from olp.passes.timing import override_speeds, path_sweep, time_program
 from olp.passes.timing.branches import path_times
 from olp.station.model import Station
 
@@ -80,3 +80,42 @@ def test_a_sweep_keeps_the_if_and_times_each_path(station: Station) -> None:
     assert paths.longest.seconds == pytest.approx(moving, rel=1e-4)
     assert paths.shortest.seconds == pytest.approx(waiting, rel=1e-4)
     assert paths.shortest.seconds < paths.longest.seconds < moving + 0.5
+
+
+def test_a_path_sweep_gives_both_ends_per_speed(station: Station) -> None:
+    branch = ir.If(
+        branches=(ir.Branch(condition=ir.DigitalInput(index=1), body=(lin(-200), lin(-400))),),
+        orelse=(ir.Wait(seconds=0.5),),
+    )
+    prog = ir.Program(name="t", instructions=(start(), branch), source="t.src")
+    compiled = olp.compile(prog, station, collisions=None)
+    options = BuildOptions(collisions=None)
+    ends = path_sweep(compiled, [0.1, 0.4], [None], options)
+    assert ends.shape == (2, 1, 2)
+    for row, linear in zip(ends[:, 0], [0.1, 0.4], strict=True):
+        paths = path_times(time_program(override_speeds(compiled, linear=linear)), options)
+        assert paths.shortest is not None and paths.longest is not None
+        assert row.tolist() == [paths.shortest.seconds, paths.longest.seconds]
+    assert ends[1, 0, 1] < ends[0, 0, 1]  # the branch that moves is faster at 0.4 m/s
+    assert ends[1, 0, 0] == pytest.approx(ends[0, 0, 0])  # the one that waits is not
+
+
+def test_olp_time_sweeps_a_program_with_branches_per_path(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    from olp.cli import main
+
+    cell = REPO / "tests" / "corpus" / "krc" / "R1"
+    args = [
+        "time",
+        str(REPO / "stations" / "kr6_milling_cell.yaml"),
+        str(cell / "Program" / "pick_part.src"),
+        "--config-dat",
+        str(cell / "System" / "$config.dat"),
+        "--no-collisions",
+        "--sweep-linear",
+        "250,500",
+    ]
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    assert "shortest path: cycle time (s)" in out and "longest path: cycle time (s)" in out
