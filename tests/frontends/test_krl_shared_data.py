@@ -144,3 +144,11 @@ def test_the_command_line_takes_data_lists(capsys: pytest.CaptureFixture[str]) -
     assert main([*args, "--data-list", str(POSITIONS)]) == 0
     assert main([*args, "--data-list", str(POSITIONS), "--data-list", str(POSITIONS)]) == 0
     assert main([*args, "--data-lists-from", str(CELL)]) == 0
+
+
+def test_a_global_signal_of_a_public_list_is_an_input(tmp_path: Path) -> None:
+    (tmp_path / "Io.dat").write_text("DEFDAT Io PUBLIC\nGLOBAL SIGNAL DOOR_OK $IN[7]\nENDDAT\n")
+    src = tmp_path / "p.src"
+    src.write_text("DEF p( )\nWAIT FOR DOOR_OK\nEND\n")
+    (wait,) = load_krl(src, data_lists_from=tmp_path).program
+    assert isinstance(wait, ir.WaitInput) and wait.index == 7

@@ -18,7 +18,10 @@ What is lowered
   name, any case) and, if given, the controller's ``$config.dat``; their ``DECL``\\ s with values
   (``E6POS/POS/FRAME/E6AXIS/AXIS``, ``PDAT/LDAT/FDAT``, numbers, ...) and value assignments
   (``TOOL_DATA[1]={...}``, ``TOOL_NAME[1,]="..."``) are the program's global variables; the
-  module's ``.dat`` wins over ``$config.dat``.
+  module's ``.dat`` wins over ``$config.dat``. Other modules' data lists (``data_lists``,
+  ``data_lists_from``: a shared ``Positions.dat``) add the names they declare ``GLOBAL`` in a
+  ``DEFDAT ... PUBLIC`` (:func:`olp.frontends.krl.data.visible_globals`: the module's own names
+  hide them; a global name declared twice is an error naming both places).
 * **Motions.** ``PTP``/``LIN``/``CIRC`` and ``SPTP``/``SLIN``/``SCIRC`` (lowered alike) to inline
   aggregates or named points (``PTP XP1``, ``PTP XHOME``, ``PTP $H_POS``). Axis values (degrees)
   become a :class:`~olp.ir.JointTarget` (all of A1..A6 needed); ``{X, Y, Z, A, B, C}`` (mm, deg)

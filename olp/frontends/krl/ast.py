@@ -297,12 +297,13 @@ class Decl:
 
 @dataclass(frozen=True, slots=True)
 class SignalDecl:
-    """``SIGNAL name $OUT[n] [TO $OUT[m]]``"""
+    """``[GLOBAL] SIGNAL name $OUT[n] [TO $OUT[m]]`` (``is_global``: GLOBAL given)"""
 
     name: str
     first: Expr
     last: Expr | None
     span: ir.SourceSpan
+    is_global: bool = False
 
 
 @dataclass(frozen=True, slots=True)

@@ -236,6 +236,9 @@ def _read_block(block: DatBlock, source: Source) -> KrlData:
             names = [item.name.upper() for item in stmt.items]
             declared_at.update((n, item.span) for n, item in zip(names, stmt.items, strict=True))
             global_names.update(names if stmt.is_global else ())
+        elif isinstance(stmt, SignalDecl):
+            declared_at[stmt.name] = stmt.span
+            global_names.update([stmt.name] if stmt.is_global else [])
         reason = _read_statement(stmt, ops, store, sources)
         if reason is not None:
             ignored.append(IgnoredLine(stmt.span, sources.snippet(stmt.span), reason))

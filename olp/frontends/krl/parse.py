@@ -349,9 +349,10 @@ class _ToAst(Transformer[Token, Module]):
 
     @_inline
     def signal_decl(
-        self, meta: Meta, _global: Any, name: Token, first: Expr, last: Expr | None
+        self, meta: Meta, is_global: Any, name: Token, first: Expr, last: Expr | None
     ) -> SignalDecl:
-        return SignalDecl(str(name).upper(), first, last, self._span(meta))
+        span = self._span(meta)
+        return SignalDecl(str(name).upper(), first, last, span, is_global is not None)
 
     def _block(self, keyword: str, meta: Meta, bodies: Sequence[Any]) -> Block:
         kept = tuple(b for b in bodies if isinstance(b, tuple))
