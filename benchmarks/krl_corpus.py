@@ -164,6 +164,23 @@ def find_config(folder: Path) -> Path | None:
     return found[0] if found else None
 
 
+def _public_lists(folder: Path) -> tuple[object, ...]:
+    """The PUBLIC data lists under ``folder``, read once: the controller finds their GLOBAL
+    names for every module (a bad one is skipped with a line on stderr)."""
+    from olp.errors import OlpError
+    from olp.frontends.krl import find_data_lists, parse_dat
+
+    lists = []
+    for path in find_data_lists(folder):
+        try:
+            data = parse_dat(path.read_bytes().decode("utf-8", "replace"), str(path))
+        except OlpError as exc:
+            print(f"data list unreadable, skipped: {exc.message}", file=sys.stderr)
+            continue
+        lists.extend([data] if data.public else [])
+    return tuple(lists)
+
+
 def run(folder: Path, station_path: Path, config: Path | None, post: str, verbose: bool) -> Tally:
     import olp
     from olp.errors import OlpError
@@ -178,7 +195,7 @@ def run(folder: Path, station_path: Path, config: Path | None, post: str, verbos
         except OlpError as exc:
             print(f"config-dat unreadable, built without it: {exc.message}", file=sys.stderr)
             print(f"  {exc.span}: {(exc.source_line or '').strip()[:80]}", file=sys.stderr)
-    options = KrlOptions(config_dat=config_data)
+    options = KrlOptions(config_dat=config_data, data_lists=_public_lists(folder))
     tally = Tally()
     for path in sorted(p for p in folder.rglob("*") if p.suffix.lower() == ".src"):
         verdict = _one(olp, path, station, options, post, tally, OlpError)

@@ -26,7 +26,7 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from olp.commands.common import EXIT_OK, EXIT_PROGRAM_ERRORS, print_diagnostics, require_files
@@ -43,6 +43,7 @@ from olp.errors import UsageError
 
 if TYPE_CHECKING:
     from olp.compiled import CompiledProgram
+    from olp.passes.pipeline import BuildOptions
 
 NAME = "time"
 HELP = "estimate a program's cycle time: per instruction, speed sweeps, trajectory CSV and plot"
@@ -133,7 +134,7 @@ def run(args: argparse.Namespace) -> int:
         return EXIT_PROGRAM_ERRORS
     _print_results(compiled, args.quiet)
     if linear or joint:
-        _print_sweep(compiled, linear, joint, other_times, args.quiet)
+        _print_sweep(compiled, linear, joint, options, args.quiet)
     _write_outputs(compiled, args)
     return EXIT_OK
 
@@ -249,20 +250,27 @@ def _print_sweep(
     compiled: CompiledProgram,
     linear: list[float],
     joint: list[float],
-    other_times: Mapping[str, float],
+    options: BuildOptions,
     quiet: bool,
 ) -> None:
-    from olp.passes.timing import speed_sweep
+    from olp.passes.timing import path_sweep, speed_sweep
     from olp.report import sweep_table
 
     rows: list[float | None] = list(linear) or [None]
     columns: list[float | None] = list(joint) or [None]
     show = not quiet and sys.stderr.isatty()
-    table = speed_sweep(compiled, rows, columns, other_times, progress=_progress if show else None)
+    report = _progress if show else None
+    if compiled.paths is not None:  # control flow: per path, as the cycle time above
+        ends = path_sweep(compiled, rows, columns, options, progress=report)
+        tables = [("shortest path", ends[..., 0]), ("longest path", ends[..., 1])]
+    else:
+        tables = [("", speed_sweep(compiled, rows, columns, options.other_times, progress=report))]
     if show:
         print("\r\033[K", end="", file=sys.stderr, flush=True)
-    print()
-    print(sweep_table(rows, columns, table))
+    for which, table in tables:
+        print()
+        title = f"{which}: " if which else ""
+        print(title + sweep_table(rows, columns, table))
 
 
 def _progress(done: int, total: int) -> None:

@@ -31,7 +31,13 @@ if TYPE_CHECKING:
 class KrlOptions:
     """How to read a KRL program. ``config_dat``: the controller's ``$config.dat`` for
     ``TOOL_DATA``/``BASE_DATA``/``XHOME`` values: a path, or one read before with
-    :func:`olp.frontends.krl.load_config_dat` (see :func:`olp.frontends.krl.load_krl`)."""
+    :func:`olp.frontends.krl.load_config_dat` (see :func:`olp.frontends.krl.load_krl`).
+    ``data_lists``: other modules' data lists (paths or :class:`KrlData`), each a
+    ``DEFDAT name PUBLIC`` whose ``GLOBAL`` declarations the program may use (a shared
+    ``Positions.dat``); ``data_lists_from``: a folder whose public data lists are all read (a
+    controller's ``R1`` folder). KRL's visibility rules:
+    :func:`olp.frontends.krl.data.visible_globals`.
+    """
 
     config_dat: str | os.PathLike[str] | KrlData | None = field(
         default=None,
@@ -41,6 +47,27 @@ class KrlOptions:
             metavar="PATH",
         ),
     )
+    data_lists: tuple[str | os.PathLike[str] | KrlData, ...] = field(
+        default=(),
+        metadata=cli(
+            "--data-list",
+            "another module's PUBLIC data list whose GLOBAL points the program uses (repeatable)",
+            metavar="PATH",
+            parse=tuple,
+            repeatable=True,
+        ),
+    )
+    data_lists_from: str | os.PathLike[str] | None = field(
+        default=None,
+        metadata=cli(
+            "--data-lists-from",
+            "read every PUBLIC data list (.dat) under this folder for GLOBAL names",
+            metavar="DIR",
+        ),
+    )
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "data_lists", tuple(self.data_lists))
 
 
 class KrlFrontend:
@@ -56,7 +83,12 @@ class KrlFrontend:
         from olp.frontends.krl import load_krl
         from olp.ir import Verbatim
 
-        result = load_krl(path, config_dat=options.config_dat)
+        result = load_krl(
+            path,
+            config_dat=options.config_dat,
+            data_lists=options.data_lists,
+            data_lists_from=options.data_lists_from,
+        )
         remarks = tuple(
             Diagnostic("warning", "krl_note", note.message, note.span) for note in result.notes
         )

@@ -18,7 +18,10 @@ What is lowered
   name, any case) and, if given, the controller's ``$config.dat``; their ``DECL``\\ s with values
   (``E6POS/POS/FRAME/E6AXIS/AXIS``, ``PDAT/LDAT/FDAT``, numbers, ...) and value assignments
   (``TOOL_DATA[1]={...}``, ``TOOL_NAME[1,]="..."``) are the program's global variables; the
-  module's ``.dat`` wins over ``$config.dat``.
+  module's ``.dat`` wins over ``$config.dat``. Other modules' data lists (``data_lists``,
+  ``data_lists_from``: a shared ``Positions.dat``) add the names they declare ``GLOBAL`` in a
+  ``DEFDAT ... PUBLIC`` (:func:`olp.frontends.krl.data.visible_globals`: the module's own names
+  hide them; a global name declared twice is an error naming both places).
 * **Motions.** ``PTP``/``LIN``/``CIRC`` and ``SPTP``/``SLIN``/``SCIRC`` (lowered alike) to inline
   aggregates or named points (``PTP XP1``, ``PTP XHOME``, ``PTP $H_POS``). Axis values (degrees)
   become a :class:`~olp.ir.JointTarget` (all of A1..A6 needed); ``{X, Y, Z, A, B, C}`` (mm, deg)
@@ -109,6 +112,7 @@ Text the grammar does not accept, and values olp needs but cannot use, raise
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 from pathlib import Path
 
 from olp import ir
@@ -126,7 +130,9 @@ __all__ = [
     "Note",
     "StatusTurn",
     "find_dat",
+    "find_data_lists",
     "load_config_dat",
+    "load_data_list",
     "load_krl",
     "parse_dat",
     "parse_krl",
@@ -139,33 +145,43 @@ def parse_krl(
     *,
     dat: KrlData | None = None,
     config: KrlData | None = None,
+    shared: Sequence[KrlData] = (),
     fast_path: bool = True,
 ) -> KrlResult:
     """Parse KRL source ``text`` (a ``.src`` file's content) and lower its first DEF.
 
     ``dat``: the module's data list (:func:`parse_dat`); ``config``: the controller's
-    ``$config.dat`` (:func:`load_config_dat`). ``fast_path=False`` reads every line with the
-    full grammar (same result, slower; for tests and benchmarks).
+    ``$config.dat`` (:func:`load_config_dat`); ``shared``: other modules' data lists, whose
+    ``GLOBAL`` names of a ``PUBLIC`` list the program sees
+    (:func:`olp.frontends.krl.data.visible_globals`). ``fast_path=False`` reads every line with
+    the full grammar (same result, slower; for tests and benchmarks).
 
     Raises :class:`olp.errors.ParseError` (with span and source line) for text that is not KRL
     olp understands; no other exception escapes for bad input.
     """
     source = Source.of(text, filename)
-    sources = SourceSet([source, *(d.source for d in (config, dat) if d is not None)])
+    data = [d for d in (config, *shared, dat) if d is not None]
+    sources = SourceSet([source, *(d.source for d in data)])
     try:
         with gc_paused():
             module = parse_module(source, fast=fast_path)
-            return lower_module(module, sources, filename, dat, config)
+            return lower_module(module, sources, filename, dat, config, shared)
     except RecursionError:
         span = ir.SourceSpan(source.filename, 1, 1)
         raise source.error("the program is nested too deeply to read", span) from None
 
 
 def load_krl(
-    path: str | os.PathLike[str], config_dat: str | os.PathLike[str] | KrlData | None = None
+    path: str | os.PathLike[str],
+    config_dat: str | os.PathLike[str] | KrlData | None = None,
+    data_lists: Sequence[str | os.PathLike[str] | KrlData] = (),
+    data_lists_from: str | os.PathLike[str] | None = None,
 ) -> KrlResult:
-    """Read a ``.src`` file, the ``.dat`` beside it (:func:`find_dat`) and an optional
-    ``$config.dat`` (a path, or one read before with :func:`load_config_dat`).
+    """Read a ``.src`` file, the ``.dat`` beside it (:func:`find_dat`), an optional
+    ``$config.dat`` (a path, or one read before with :func:`load_config_dat`) and other
+    modules' data lists: ``data_lists`` (each must be ``PUBLIC``: :func:`load_data_list`) and
+    the ``PUBLIC`` ones found under the folder ``data_lists_from`` (:func:`find_data_lists`).
+    The module's own ``.dat`` is never read twice.
 
     Files are UTF-8, else Windows-1252 (what KUKA controllers write), else Latin-1.
     Raises :class:`olp.errors.UsageError` if a file cannot be read and
@@ -176,7 +192,8 @@ def load_krl(
         config = load_config_dat(config_dat)  # type: ignore[arg-type]
     dat_path = find_dat(path)
     dat = None if dat_path is None else parse_dat(_read(dat_path, "data list"), os.fspath(dat_path))
-    return parse_krl(_read(path, "KRL"), os.fspath(path), dat=dat, config=config)
+    shared = _shared_lists(data_lists, data_lists_from, dat_path)
+    return parse_krl(_read(path, "KRL"), os.fspath(path), dat=dat, config=config, shared=shared)
 
 
 def load_config_dat(path: str | os.PathLike[str]) -> KrlData:
@@ -211,6 +228,65 @@ def find_dat(path: str | os.PathLike[str]) -> Path | None:
         names = ", ".join(p.name for p in matches)
         raise UsageError(f"several data lists match {src.name}: {names}")
     return matches[0] if matches and matches[0].is_file() else None
+
+
+def load_data_list(path: str | os.PathLike[str] | KrlData) -> KrlData:
+    """Another module's data list, read for the names it declares ``GLOBAL``: a
+    :class:`ParseError` at its ``DEFDAT`` line unless it is ``DEFDAT name PUBLIC`` (only a
+    public list shares names; ``$config.dat`` is given as ``config_dat`` instead)."""
+    data = (
+        path if isinstance(path, KrlData) else parse_dat(_read(path, "data list"), os.fspath(path))
+    )
+    if not data.public:
+        lines = enumerate(data.source.lines, 1)
+        line = next((n for n, text in lines if text.lstrip().upper().startswith("DEFDAT")), 1)
+        span = ir.SourceSpan(data.filename, line, 1)
+        config = data.name.upper() == "$CONFIG"
+        raise data.source.error(
+            f"DEFDAT {data.name} is not PUBLIC: other modules do not see its names",
+            span,
+            hint="give the controller's $config.dat with --config-dat"
+            if config
+            else "only the GLOBAL declarations of a DEFDAT ... PUBLIC list are shared",
+        )
+    return data
+
+
+def find_data_lists(folder: str | os.PathLike[str]) -> list[Path]:
+    """The ``.dat`` files under ``folder`` (any depth, any case of the suffix), sorted, without
+    ``$config.dat`` (given with ``config_dat``); :class:`UsageError` if it is not a folder."""
+    root = Path(folder)
+    if not root.is_dir():
+        raise UsageError(f"cannot read data lists from {os.fspath(folder)!r}: not a folder")
+    found = (p for p in root.rglob("*") if p.suffix.lower() == ".dat" and p.is_file())
+    return sorted(p for p in found if p.name.lower() != "$config.dat")
+
+
+def _shared_lists(
+    given: Sequence[str | os.PathLike[str] | KrlData],
+    folder: str | os.PathLike[str] | None,
+    own: Path | None,
+) -> list[KrlData]:
+    """The data lists of ``given`` and the public ones under ``folder``, each file once and
+    without the module's own ``.dat`` (``own``), whose names are the module's anyway."""
+    seen = set() if own is None else {own.resolve()}
+    lists = []
+    for item in given:
+        if _once(Path(item.filename if isinstance(item, KrlData) else item), seen):
+            lists.append(load_data_list(item))
+    for found in find_data_lists(folder) if folder is not None else ():
+        if _once(found, seen):
+            data = parse_dat(_read(found, "data list"), os.fspath(found))
+            lists.extend([data] if data.public else [])
+    return lists
+
+
+def _once(path: Path, seen: set[Path]) -> bool:
+    """Whether ``path`` is new to ``seen`` (and add it)."""
+    key = path.resolve()
+    new = key not in seen
+    seen.add(key)
+    return new
 
 
 def _read(path: str | os.PathLike[str], what: str) -> str:

@@ -287,21 +287,23 @@ class DeclItem:
 
 @dataclass(frozen=True, slots=True)
 class Decl:
-    """``DECL [GLOBAL] [CONST] TYPE name[dims] [= value], ...``"""
+    """``DECL [GLOBAL] [CONST] TYPE name[dims] [= value], ...`` (``is_global``: GLOBAL given)"""
 
     type_name: str
     items: tuple[DeclItem, ...]
     span: ir.SourceSpan
+    is_global: bool = False
 
 
 @dataclass(frozen=True, slots=True)
 class SignalDecl:
-    """``SIGNAL name $OUT[n] [TO $OUT[m]]``"""
+    """``[GLOBAL] SIGNAL name $OUT[n] [TO $OUT[m]]`` (``is_global``: GLOBAL given)"""
 
     name: str
     first: Expr
     last: Expr | None
     span: ir.SourceSpan
+    is_global: bool = False
 
 
 @dataclass(frozen=True, slots=True)
@@ -410,9 +412,12 @@ class Routine:
 
 @dataclass(frozen=True, slots=True)
 class DatBlock:
+    """``DEFDAT name [PUBLIC]`` ... ``ENDDAT``."""
+
     name: str
     body: tuple[Stmt, ...]
     span: ir.SourceSpan
+    public: bool = False
 
 
 @dataclass(frozen=True, slots=True)

@@ -15,8 +15,8 @@ routines, so both follow the same rules.
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
 
 from olp import ir
 from olp.errors import ParseError
@@ -76,10 +76,20 @@ class KrlData:
     values: Mapping[str, Value]
     ignored: tuple[IgnoredLine, ...]
     source: Source
+    public: bool = False
+    declared_at: Mapping[str, ir.SourceSpan] = field(default_factory=dict)
+    global_names: frozenset[str] = frozenset()
 
     def names(self) -> tuple[str, ...]:
         """The declared names (upper case), in the order they were read."""
         return tuple(self.values)
+
+    def exported(self) -> tuple[str, ...]:
+        """The names other modules see: those declared ``GLOBAL`` in a ``DEFDAT ... PUBLIC``
+        (:func:`visible_globals` gives the rule and its source)."""
+        if not self.public:
+            return ()
+        return tuple(n for n in self.values if n in self.global_names)
 
 
 class DataOps:
@@ -215,11 +225,20 @@ def _read_block(block: DatBlock, source: Source) -> KrlData:
     variables = Variables(values, missing)
     ops = DataOps(variables, Evaluator(variables, sources.snippet), sources)
     ignored: list[IgnoredLine] = []
+    declared_at: dict[str, ir.SourceSpan] = {}
+    global_names: set[str] = set()
 
     def store(name: str, value: Value) -> None:
         values[name] = value
 
     for stmt in block.body:
+        if isinstance(stmt, Decl):
+            names = [item.name.upper() for item in stmt.items]
+            declared_at.update((n, item.span) for n, item in zip(names, stmt.items, strict=True))
+            global_names.update(names if stmt.is_global else ())
+        elif isinstance(stmt, SignalDecl):
+            declared_at[stmt.name] = stmt.span
+            global_names.update([stmt.name] if stmt.is_global else [])
         reason = _read_statement(stmt, ops, store, sources)
         if reason is not None:
             ignored.append(IgnoredLine(stmt.span, sources.snippet(stmt.span), reason))
@@ -229,6 +248,55 @@ def _read_block(block: DatBlock, source: Source) -> KrlData:
         values=values,
         ignored=tuple(ignored),
         source=source,
+        public=block.public,
+        declared_at=declared_at,
+        global_names=frozenset(global_names),
+    )
+
+
+# ------------------------------------------------------------------------------------------------
+# Names other modules declare
+
+
+def visible_globals(
+    config: KrlData | None, shared: Sequence[KrlData], dat: KrlData | None
+) -> dict[str, Value]:
+    """The global variables a module sees, as the controller finds them: every name of
+    ``$config.dat``, the ``GLOBAL`` names of the ``PUBLIC`` data lists in ``shared``, then the
+    module's own ``.dat``, whose names hide global ones of the same name.
+
+    KRL's rule (KUKA, KSS 8.x expert programming / system integrator manuals, "global data
+    lists"; recalled, the text was not found to quote): a variable of a data list is visible to
+    other modules only when the list is declared ``DEFDAT name PUBLIC`` *and* the variable
+    ``DECL GLOBAL``; ``$CONFIG.DAT`` is the controller's global data list, whose declarations are
+    global without the keyword; a module's own names hide global ones. A global name declared
+    twice (in two lists, or in the module's own ``PUBLIC`` list and another) is refused by the
+    controller: here a :class:`ParseError` at the second declaration naming the first.
+    """
+    values: dict[str, Value] = {}
+    owner: dict[str, KrlData] = {}
+    publishers = [(config, config.names())] if config is not None else []
+    publishers += [(data, data.exported()) for data in shared]
+    publishers += [(dat, dat.exported())] if dat is not None else []
+    for data, names in publishers:
+        for name in names:
+            if name in owner and owner[name] is not data:
+                raise _declared_twice(name, owner[name], data)
+            owner[name] = data
+            values[name] = data.values[name]
+    if dat is not None:
+        values.update(dat.values)
+    return values
+
+
+def _declared_twice(name: str, first: KrlData, second: KrlData) -> ParseError:
+    span = second.declared_at.get(name, ir.SourceSpan(second.filename, 1, 1))
+    where = first.declared_at.get(name, ir.SourceSpan(first.filename, 1, 1))
+    return second.source.error(
+        f"{name} is declared GLOBAL twice: at {where.location} and here",
+        span,
+        hint="the controller refuses a global name declared in two data lists; rename one, or "
+        "give olp only the data lists the controller holds",
     )
 
 

@@ -27,7 +27,6 @@ from olp.frontends.krl.ast import (
     FastMotion,
     ForLoop,
     IgnoredLine,
-    Index,
     InterruptCtl,
     InterruptDecl,
     Module,
@@ -43,7 +42,7 @@ from olp.frontends.krl.ast import (
     WaitFor,
     WaitSec,
 )
-from olp.frontends.krl.data import OTHER_REASONS, KrlData
+from olp.frontends.krl.data import OTHER_REASONS, KrlData, visible_globals
 from olp.frontends.krl.events import Events
 from olp.frontends.krl.flow import assigned_names, is_straight, jump_targets, statements, to_expr
 from olp.frontends.krl.motion import Motions
@@ -592,18 +591,6 @@ class _Lowering(Motions, Events):
         assert converted is not None
         return converted
 
-    def _input_index(self, var: Var) -> int | None:
-        if var.key == "$IN[]":
-            index = var.selectors[0]
-            assert isinstance(index, Index)
-            arg = index.args[0] if len(index.args) == 1 else None
-            return None if arg is None else as_int(self._value(arg))
-        if not var.selectors:
-            signal = self._value(var)
-            if isinstance(signal, Signal) and signal.io == "$IN":
-                return signal.index
-        return None
-
     # ---- jumps
     def _goto(self, stmt: Other) -> None:
         name = (stmt.name or "").upper()
@@ -720,20 +707,25 @@ _SETTING_NAMES = {
 
 
 def lower_module(
-    module: Module, sources: SourceSet, src: str, dat: KrlData | None, config: KrlData | None
+    module: Module,
+    sources: SourceSet,
+    src: str,
+    dat: KrlData | None,
+    config: KrlData | None,
+    shared: Sequence[KrlData] = (),
 ) -> KrlResult:
-    """Lower the first DEF of ``module``; the other routines are inlined where called."""
+    """Lower the first DEF of ``module``; the other routines are inlined where called.
+    ``shared``: other modules' data lists whose GLOBAL names the module sees
+    (:func:`~olp.frontends.krl.data.visible_globals`)."""
     routines = _routines(module, sources, src)
+    values = visible_globals(config, shared, dat)
+    data = [d for d in (config, *shared, dat) if d is not None]
     if not any(r.kind == "DEF" for r in routines):
-        return _functions_only(routines, sources, src, dat, config)
+        return _functions_only(routines, sources, src, dat, config, data)
     main = next(r for r in routines if r.kind == "DEF")
     routines = [main, *(r for r in routines if r is not main)]
     table = {r.name.upper(): r for r in routines}
-    ctx = Context(sources, table, src, dat, config, MAX_LOWERED_STATEMENTS)
-    data = [d for d in (config, dat) if d is not None]
-    values: dict[str, Value] = {}
-    for datum in data:  # the module's .dat comes last: its names win
-        values.update(datum.values)
+    ctx = Context(sources, table, src, dat, config, MAX_LOWERED_STATEMENTS, shared)
     variables = Variables(values, ctx.unknown_name)
     variables.push(
         {
@@ -797,6 +789,7 @@ def _functions_only(
     src: str,
     dat: KrlData | None,
     config: KrlData | None,
+    data: list[KrlData],
 ) -> KrlResult:
     """A module of functions only (a library of DEFFCTs, called from other modules): there is no
     program to run, so the program is empty and every function is reported as not lowered."""
@@ -813,7 +806,6 @@ def _functions_only(
     for data_list in (dat, config):
         ignored.extend(data_list.ignored if data_list is not None else ())
     name = os.path.splitext(os.path.basename(src))[0] or routines[0].name
-    data = [d for d in (config, dat) if d is not None]
     return KrlResult(
         program=ir.Program(name=name, instructions=(), source=src),
         ignored=tuple(ignored),

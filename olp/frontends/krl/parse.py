@@ -112,6 +112,11 @@ class _With:
 _NOT_TARGETS = (_CircAngle, _With, Token)
 
 
+def _is_global(children: tuple[Any, ...]) -> bool:
+    """Whether a declaration's modifiers hold GLOBAL (before or after DECL)."""
+    return any(isinstance(c, Token) and c.type == "GLOBAL" for c in children)
+
+
 class _Case:
     __slots__ = ("body", "values")
 
@@ -214,8 +219,8 @@ class _ToAst(Transformer[Token, Module]):
         )
 
     @_inline
-    def dat_block(self, meta: Meta, name: Token, _public: Any, body: tuple[Stmt, ...]) -> DatBlock:
-        return DatBlock(str(name), body, self._span(meta))
+    def dat_block(self, meta: Meta, name: Token, public: Any, body: tuple[Stmt, ...]) -> DatBlock:
+        return DatBlock(str(name), body, self._span(meta), public=public is not None)
 
     def body(self, children: list[Any]) -> tuple[Stmt, ...]:
         statements: list[Stmt] = []
@@ -305,7 +310,7 @@ class _ToAst(Transformer[Token, Module]):
     def decl(self, meta: Meta, *children: Any) -> Decl:
         type_name = next(c for c in children if isinstance(c, str) and not isinstance(c, Token))
         items = tuple(c for c in children if isinstance(c, DeclItem))
-        return Decl(type_name.upper(), items, self._span(meta))
+        return Decl(type_name.upper(), items, self._span(meta), _is_global(children))
 
     @_inline
     def bare_decl(self, meta: Meta, *children: Any) -> Decl:
@@ -324,7 +329,7 @@ class _ToAst(Transformer[Token, Module]):
                 first.span,
                 self._source_line(first.span.line),
             )
-        return Decl(str(type_name).upper(), items, self._span(meta))
+        return Decl(str(type_name).upper(), items, self._span(meta), _is_global(children))
 
     @_inline
     def type_name(self, meta: Meta, name: Any) -> str:
@@ -344,9 +349,10 @@ class _ToAst(Transformer[Token, Module]):
 
     @_inline
     def signal_decl(
-        self, meta: Meta, _global: Any, name: Token, first: Expr, last: Expr | None
+        self, meta: Meta, is_global: Any, name: Token, first: Expr, last: Expr | None
     ) -> SignalDecl:
-        return SignalDecl(str(name).upper(), first, last, self._span(meta))
+        span = self._span(meta)
+        return SignalDecl(str(name).upper(), first, last, span, is_global is not None)
 
     def _block(self, keyword: str, meta: Meta, bodies: Sequence[Any]) -> Block:
         kept = tuple(b for b in bodies if isinstance(b, tuple))

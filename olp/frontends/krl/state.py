@@ -234,6 +234,7 @@ class Context:
         dat: KrlData | None,
         config: KrlData | None,
         budget: int,
+        shared: Sequence[KrlData] = (),
     ) -> None:
         self.sources = sources
         self.routines = routines
@@ -243,6 +244,7 @@ class Context:
         self.budget = self.remaining = budget
         self.config = config
         self.module_dat = dat
+        self.shared = tuple(shared)
         self._where = self._describe_files(src)
 
     def _describe_files(self, src: str) -> str:
@@ -250,7 +252,8 @@ class Context:
             "no .dat file beside it" if self.module_dat is None else data_file_name(self.module_dat)
         )
         config = "no $config.dat given" if self.config is None else data_file_name(self.config)
-        return f"{os.path.basename(src)} ({dat}; {config})"
+        shared = "".join(f"; {data_file_name(d)}" for d in self.shared)
+        return f"{os.path.basename(src)} ({dat}; {config}{shared})"
 
     def unknown_name(self, name: str) -> Unknown:
         """Why ``name`` has no value: a controller variable, or declared nowhere olp looked."""
@@ -272,6 +275,11 @@ class Context:
             hints.append(
                 "XHOME, FHOME, PDEFAULT, TOOL_DATA and BASE_DATA are declared in the "
                 "controller's $config.dat: pass it (--config-dat, or KrlOptions(config_dat=...))"
+            )
+        if not self.shared:
+            hints.append(
+                "a point declared GLOBAL in another module's PUBLIC data list is found with "
+                "--data-list FILE.dat or --data-lists-from FOLDER (KrlOptions(data_lists=...))"
             )
         return Unknown(f"{name} is not declared in {self._where}", "; ".join(hints) or None)
 
@@ -357,9 +365,24 @@ class Core:
         """``stmt`` as IR: a statement of the program, kept whatever olp knows of its value."""
         from olp.frontends.krl.flow import to_expr
 
-        target, value = (to_expr(e, lambda _: None) for e in (stmt.target, stmt.value))
+        target = to_expr(stmt.target, lambda _: None)
+        value = to_expr(stmt.value, self._input_index)
         assert target is not None and value is not None
         return ir.Assign(target=target, value=value, span=stmt.span)
+
+    def _input_index(self, var: Var) -> int | None:
+        """The input number of ``$IN[n]`` (a constant ``n``) or of a one-bit SIGNAL of an
+        input: read as :class:`~olp.ir.DigitalInput` wherever an expression is."""
+        if var.key == "$IN[]":
+            index = var.selectors[0]
+            assert isinstance(index, Index)
+            arg = index.args[0] if len(index.args) == 1 else None
+            return None if arg is None else as_int(self._value(arg))
+        if not var.selectors:
+            signal = self._value(var)
+            if isinstance(signal, Signal) and signal.io == "$IN":
+                return signal.index
+        return None
 
     def _keep(self, stmt: Stmt | Assign, reason: str) -> None:
         """Keep a statement olp does not model as :class:`~olp.ir.Verbatim` (its text without

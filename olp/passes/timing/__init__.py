@@ -129,7 +129,7 @@ from olp.passes.timing.problem import PathProblem, speed_bounds
 from olp.passes.timing.program import time_program, timing_pass
 from olp.passes.timing.ptp import RUCKIG_MAX_DURATION, ptp_duration, ptp_profile
 from olp.passes.timing.reachability import PathSolver, reachability_speeds
-from olp.passes.timing.sweep import override_speeds, speed_sweep
+from olp.passes.timing.sweep import override_speeds, path_sweep, speed_sweep
 from olp.passes.timing.tcp import tcp_rates
 
 __all__ = [
@@ -154,6 +154,7 @@ __all__ = [
     "line_profiles",
     "override_speeds",
     "path_problem",
+    "path_sweep",
     "ptp_duration",
     "ptp_profile",
     "reachability_speeds",
