@@ -644,7 +644,9 @@ def _tool_checks(
 
 def _joint_position_notes(post: FanucPost, motions: Sequence[Any], robot: Any) -> list[Diagnostic]:
     """Info per Cartesian target written in joint form (no CONFIG selects it alone)."""
-    cartesian = [s for s in motions if _is_cartesian(s.instruction)]
+    from olp.ir import CartesianTarget
+
+    cartesian = [s for s in motions if isinstance(s.instruction.target, CartesianTarget)]
     if not cartesian:
         return []
     joints = np.stack([np.asarray(s.joints, dtype=np.float64) for s in cartesian])
@@ -658,12 +660,6 @@ def _joint_position_notes(post: FanucPost, motions: Sequence[Any], robot: Any) -
             )
             out.append(_diag("info", "joint_position", msg, step))
     return out
-
-
-def _is_cartesian(instruction: Any) -> bool:
-    from olp.ir import CartesianTarget
-
-    return isinstance(instruction.target, CartesianTarget)
 
 
 def _written(post: Post, pose: ArrayLike) -> str:
