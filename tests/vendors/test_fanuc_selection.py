@@ -112,6 +112,17 @@ def test_fast_selection_equals_the_reference_on_random_and_boundary_joints(cell:
     assert np.sum(np.abs(wrist_x(robot, q)) < 3e-9) > 100  # and the shoulder's
 
 
+def test_fast_selection_equals_the_reference_with_turn_variants_on_every_joint() -> None:
+    # Limits beyond +-180 deg on every joint: J2, J3 and J5 get 2-3 turn variants too, so the
+    # (J2, J3) shift pairs and the J5 sign test on shifted values are exercised.
+    robot = _robot("fanuc_m20ia_weld_cell.yaml")
+    wide = np.radians([250.0, 200.0, 300.0, 400.0, 190.0, 420.0])
+    limits = dataclasses.replace(robot.limits, lower=-wide, upper=wide)
+    robot = dataclasses.replace(robot, limits=limits)
+    q = _edge_joints(robot, 4000, seed=21)
+    assert fanuc.selecting_configs(robot, q) == fanuc.selecting_configs_reference(robot, q)
+
+
 def test_fast_selection_equals_the_reference_on_a_helix() -> None:
     robot = _robot("fanuc_m20ia_weld_cell.yaml")
     q = _helix_joints(5000)
