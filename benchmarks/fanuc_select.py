@@ -7,14 +7,22 @@ variant); both must agree. Prints seconds, points/s and the peak of numpy/Python
 (tracemalloc, a second pass) of each, with the ratios. Run with one BLAS thread for numbers
 comparable to the full builds (``OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1``).
 
-    python benchmarks/fanuc_select.py [N]
+With ``--reference DIR`` (a checkout of other olp code, e.g. ``git archive main | tar -x -C
+DIR``) it also builds the helix as a CSV on the weld cell, ``olp build ... --post fanuc`` with
+all checks, collisions and timing, in fresh interpreters (:mod:`benchmarks.full_builds`),
+alternating that code and this code ``--repeat`` times, and prints the best wall time and
+peak memory of each with the ratios.
+
+    python benchmarks/fanuc_select.py [N] [--reference DIR] [--repeat K]
 
 Last lines: ``name: value unit``.
 """
 
 from __future__ import annotations
 
+import argparse
 import sys
+import tempfile
 import time
 import tracemalloc
 from collections.abc import Callable
@@ -59,8 +67,49 @@ def measure(select: Callable[[Any, np.ndarray], list[str | None]], robot: Any, q
     return result, seconds, peak
 
 
+def helix_csv(count: int, path: Path) -> None:
+    """The helix of :func:`helix_joints` as CSV rows x, y, z (mm, in the weld table frame)."""
+    t = np.linspace(0.0, 40.0 * np.pi, count)
+    xyz = np.c_[-300 + 60 * np.cos(t), 60 * np.sin(t), 20 + np.linspace(0.0, 30.0, count)]
+    np.savetxt(path, xyz, fmt="%.4f", delimiter=",", header="x,y,z", comments="")
+
+
+def builds(count: int, reference: Path, repeat: int) -> list[tuple[str, float, str]]:
+    """Best wall time (s) and peak memory (MB) of the weld-cell build, reference and this."""
+    sys.path.insert(0, str(REPO / "benchmarks"))
+    from full_builds import run_olp
+
+    best: dict[str, tuple[float, float]] = {}
+    with tempfile.TemporaryDirectory() as scratch:
+        csv = Path(scratch) / "helix.csv"
+        helix_csv(count, csv)
+        for _ in range(repeat):
+            for label, code in (("reference_", reference.resolve()), ("", None)):
+                wall, peak, exit_code = run_olp(
+                    "build", str(CELL), str(csv), "--frame", "weld_table", "--orientation",
+                    "180,0,180", "--post", "fanuc", "-o", str(Path(scratch) / "out"), "--quiet",
+                    code=code,
+                )  # fmt: skip
+                if exit_code != 0:
+                    raise SystemExit(f"{label}build exited {exit_code}")
+                old = best.get(label, (np.inf, np.inf))
+                best[label] = (min(old[0], wall), min(old[1], peak))
+    out = []
+    for label in ("reference_", ""):
+        out.append((f"{label}fanuc_weld_{count}_build_seconds", best[label][0], "s"))
+        out.append((f"{label}fanuc_weld_{count}_peak_memory", best[label][1], "MB"))
+    out.append(("fanuc_weld_build_vs_reference", best[""][0] / best["reference_"][0], "x"))
+    out.append(("fanuc_weld_memory_vs_reference", best[""][1] / best["reference_"][1], "x"))
+    return out
+
+
 def main() -> None:
-    count = int(sys.argv[1]) if len(sys.argv) > 1 else 100_000
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("points", nargs="?", type=int, default=100_000)
+    parser.add_argument("--reference", type=Path, default=None)
+    parser.add_argument("--repeat", type=int, default=1)
+    args = parser.parse_args()
+    count = args.points
     robot, q = helix_joints(count)
     fast, fast_s, fast_mb = measure(fanuc.selecting_configs, robot, q)
     ref, ref_s, ref_mb = measure(fanuc.selecting_configs_reference, robot, q)
@@ -77,6 +126,9 @@ def main() -> None:
     print(f"fanuc_select_peak_traced: {fast_mb:.1f} MB")
     print(f"fanuc_select_reference_peak_traced: {ref_mb:.1f} MB")
     print(f"fanuc_select_memory_ratio: {fast_mb / ref_mb:.3f} x")
+    if args.reference is not None:
+        for name, value, unit in builds(count, args.reference, args.repeat):
+            print(f"{name}: {value:.3f} {unit}")
 
 
 if __name__ == "__main__":
