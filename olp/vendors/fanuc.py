@@ -282,7 +282,7 @@ def _config_texts(q: FloatArray, flags: Any) -> list[str]:
     flags, each distinct value formatted once."""
     turns = turn_number(q[:, list(TURN_AXES)])
     codes = np.column_stack([flags.flip, flags.down, flags.back, turns]).astype(np.int64)
-    if np.all(np.abs(turns) < _PACK // 2):  # one int64 per row: a 1-d unique is ~10x faster
+    if np.all((turns > -_PACK // 2) & (turns < _PACK // 2)):  # a 1-d unique is ~10x faster
         packed = codes[:, 0] * 4 + codes[:, 1] * 2 + codes[:, 2]
         for k in (3, 4, 5):
             packed = packed * _PACK + (codes[:, k] + _PACK // 2)
