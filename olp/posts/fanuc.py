@@ -507,7 +507,7 @@ class FanucPost(Post):
 
     def __init__(self, manifest: Any) -> None:
         super().__init__(manifest)
-        self._configs: dict[int, tuple[Any, dict[bytes, str | None]]] = {}
+        self._configs: dict[int, tuple[Any, _SelectionMemo]] = {}
 
     def check_instruction(self, step: Step, compiled: CompiledProgram) -> list[Diagnostic]:
         """``speed_raised`` (warning): a speed LS cannot write so slow, written at its least
@@ -536,17 +536,17 @@ class FanucPost(Post):
     def selecting_configs(self, robot: Any, joints: Any) -> list[str | None]:
         """:func:`olp.vendors.fanuc.selecting_configs`, remembered per joint vector for this
         post and robot: the checks and the render ask for the same motions (an IK per row)."""
-        q = np.asarray(joints, dtype=np.float64).reshape(-1, 6)
+        q = np.ascontiguousarray(joints, dtype=np.float64).reshape(-1, 6)
         memo = self._configs.get(id(robot))
         if memo is None or memo[0] is not robot:
-            memo = self._configs[id(robot)] = (robot, {})
-        known = memo[1]
-        keys = [row.tobytes() for row in q]
-        missing = [k for k, key in enumerate(keys) if key not in known]
-        if missing:
-            found = selecting_configs(robot, q[missing])
-            known.update(zip((keys[k] for k in missing), found, strict=True))
-        return [known[key] for key in keys]
+            memo = self._configs[id(robot)] = (robot, _SelectionMemo())
+        out, missing = memo[1].lookup(q)
+        if missing.size:
+            found = np.empty(missing.size, dtype=object)
+            found[:] = selecting_configs(robot, q[missing])
+            memo[1].add(q[missing], found)
+            out[missing] = found
+        return list(out)
 
     def check_program(self, compiled: CompiledProgram) -> list[Diagnostic]:
         """Frame and tool numbers LS cannot write (errors), a tool number olp chose (warning,
@@ -644,7 +644,9 @@ def _tool_checks(
 
 def _joint_position_notes(post: FanucPost, motions: Sequence[Any], robot: Any) -> list[Diagnostic]:
     """Info per Cartesian target written in joint form (no CONFIG selects it alone)."""
-    cartesian = [s for s in motions if _is_cartesian(s.instruction)]
+    from olp.ir import CartesianTarget
+
+    cartesian = [s for s in motions if isinstance(s.instruction.target, CartesianTarget)]
     if not cartesian:
         return []
     joints = np.stack([np.asarray(s.joints, dtype=np.float64) for s in cartesian])
@@ -658,12 +660,6 @@ def _joint_position_notes(post: FanucPost, motions: Sequence[Any], robot: Any) -
             )
             out.append(_diag("info", "joint_position", msg, step))
     return out
-
-
-def _is_cartesian(instruction: Any) -> bool:
-    from olp.ir import CartesianTarget
-
-    return isinstance(instruction.target, CartesianTarget)
 
 
 def _written(post: Post, pose: ArrayLike) -> str:
@@ -680,3 +676,48 @@ def _spell(values: Sequence[str]) -> str:
 
 def _diag(severity: Any, kind: str, message: str, step: Any) -> Diagnostic:
     return Diagnostic(severity, kind, message, step.instruction.span, step.index)
+
+
+class _SelectionMemo:
+    """CONFIG selections (:func:`olp.vendors.fanuc.selecting_configs`) remembered per joint
+    vector, the rows found by a 64-bit hash of their bytes (sorted, ``np.searchsorted``) and
+    confirmed by comparing all their bytes: a hit is the same row bit for bit (as a dict keyed
+    by ``row.tobytes()`` would find it), a hash collision only a miss. About 64 bytes per row
+    and no Python object per row (a dict of bytes keys took ~150 bytes and 3 us per row)."""
+
+    def __init__(self) -> None:
+        self.hashes = np.empty(0, dtype=np.uint64)
+        self.bits = np.empty((0, 6), dtype=np.uint64)
+        self.configs = np.empty(0, dtype=object)
+
+    def lookup(self, q: NDArray[np.float64]) -> tuple[NDArray[np.object_], NDArray[np.intp]]:
+        """Known selections (n,) of joints (n, 6) rad (None where unknown) and the indices
+        of the unknown rows."""
+        bits = q.view(np.uint64)
+        out = np.full(q.shape[0], None, dtype=object)
+        if self.hashes.size == 0:
+            return out, np.arange(q.shape[0])
+        h = _row_hashes(bits)
+        at = np.minimum(np.searchsorted(self.hashes, h), self.hashes.size - 1)
+        hit = (self.hashes[at] == h) & np.all(self.bits[at] == bits, axis=-1)
+        out[hit] = self.configs[at[hit]]
+        return out, np.flatnonzero(~hit)
+
+    def add(self, q: NDArray[np.float64], configs: NDArray[np.object_]) -> None:
+        """Remember the selections (m,) of joints (m, 6) rad."""
+        bits = np.ascontiguousarray(q).view(np.uint64)
+        hashes = np.concatenate([self.hashes, _row_hashes(bits)])
+        order = np.argsort(hashes, kind="stable")
+        self.hashes = hashes[order]
+        self.bits = np.concatenate([self.bits, bits])[order]
+        self.configs = np.concatenate([self.configs, configs])[order]
+
+
+def _row_hashes(bits: NDArray[np.uint64]) -> NDArray[np.uint64]:
+    """A 64-bit FNV-style hash (n,) of rows (n, 6) of float bits (wrapping arithmetic)."""
+    h = np.full(bits.shape[0], 0xCBF29CE484222325, dtype=np.uint64)
+    for j in range(bits.shape[1]):
+        h ^= bits[:, j]
+        h *= np.uint64(0x100000001B3)
+        h ^= h >> np.uint64(29)
+    return h

@@ -234,26 +234,71 @@ def has_config(robot: Any) -> bool:
 def selecting_configs(robot: Any, joints: ArrayLike) -> list[str | None]:
     """Per planned joint vector (N, 6) rad: its CONFIG when that selects it alone among the IK
     solutions (with turn variants, within the limits) of its pose, else None (write the position
-    as joints). Vectorised in batches of :data:`SELECT_ROWS`: IK for all poses of a batch at
-    once, :func:`satisfies` once per distinct CONFIG."""
+    as joints).
 
+    The definition is :func:`selecting_configs_reference`: CONFIG ``C`` of joints ``q`` selects
+    them when some candidate satisfies ``C`` and every candidate that does lies within
+    :data:`CONFIG_TOLERANCE` of ``q``. This function computes the same booleans without
+    building the 8 x 18 candidate rows per point (:func:`_selecting_configs`, where the proof
+    is); robots whose shoulder or elbow flag would depend on more than J2 and J3 take the
+    reference. Batches of :data:`SELECT_ROWS` bound the memory.
+    """
+    q = np.asarray(joints, dtype=np.float64).reshape(-1, 6)
+    if q.shape[0] == 0 or not has_config(robot):
+        return [None] * q.shape[0]
+    select = _selecting_configs if _flags_follow_j2_j3(robot) else _selecting_configs_reference
+    out: list[str | None] = []
+    for lo in range(0, q.shape[0], SELECT_ROWS):
+        out += select(robot, q[lo : lo + SELECT_ROWS])
+    return out
+
+
+def selecting_configs_reference(robot: Any, joints: ArrayLike) -> list[str | None]:
+    """:func:`selecting_configs` by its definition: every IK solution of every pose with all its
+    turn variants (:func:`olp.kinematics.base.turn_variants`), tested with
+    :func:`olp.kinematics.configuration.satisfies`. Slow (about 30 kB and 0.1 ms per point);
+    kept as the statement the fast path is tested against."""
     q = np.asarray(joints, dtype=np.float64).reshape(-1, 6)
     if q.shape[0] == 0 or not has_config(robot):
         return [None] * q.shape[0]
     out: list[str | None] = []
     for lo in range(0, q.shape[0], SELECT_ROWS):
-        out += _selecting_configs(robot, q[lo : lo + SELECT_ROWS])
+        out += _selecting_configs_reference(robot, q[lo : lo + SELECT_ROWS])
     return out
 
 
 SELECT_ROWS = 4096
-"""Joint vectors per batch of :func:`selecting_configs`: each row holds its IK solutions with
-their turn variants (8 branches x up to 18 turns x 6 joints) and the masks over them, about
-30 kB; batches keep a toolpath's memory bounded (a million rows at once took ~30 GB)."""
+"""Joint vectors per batch of :func:`selecting_configs`. The reference path holds per row its IK
+solutions with their turn variants (8 branches x up to 18 turns x 6 joints) and the masks over
+them, about 30 kB (a million rows at once took ~30 GB); the fast path about 3 kB."""
 
 
-def _selecting_configs(robot: Any, q: FloatArray) -> list[str | None]:
-    """:func:`selecting_configs` of one batch (n, 6) rad."""
+_PACK = 1 << 16
+"""Range of one packed turn number in :func:`_config_texts` (8 x 2**48 fits an int64)."""
+
+
+def _config_texts(q: FloatArray, flags: Any) -> list[str]:
+    """The CONFIG text (:class:`FanucConfig`) of each joint vector (n, 6) rad with its branch
+    flags, each distinct value formatted once."""
+    turns = turn_number(q[:, list(TURN_AXES)])
+    codes = np.column_stack([flags.flip, flags.down, flags.back, turns]).astype(np.int64)
+    if np.all((turns > -_PACK // 2) & (turns < _PACK // 2)):  # a 1-d unique is ~10x faster
+        packed = codes[:, 0] * 4 + codes[:, 1] * 2 + codes[:, 2]
+        for k in (3, 4, 5):
+            packed = packed * _PACK + (codes[:, k] + _PACK // 2)
+        _, first, inverse = np.unique(packed, return_index=True, return_inverse=True)
+        distinct = codes[first]
+    else:
+        distinct, inverse = np.unique(codes, axis=0, return_inverse=True)
+    texts = [
+        str(FanucConfig(not f, not d, not b, (int(t1), int(t4), int(t6))))
+        for f, d, b, t1, t4, t6 in distinct.tolist()
+    ]
+    return [texts[k] for k in inverse.reshape(-1).tolist()]
+
+
+def _selecting_configs_reference(robot: Any, q: FloatArray) -> list[str | None]:
+    """:func:`selecting_configs_reference` of one batch (n, 6) rad."""
     from olp.kinematics.base import turn_variants
     from olp.kinematics.configuration import satisfies
 
@@ -273,3 +318,155 @@ def _selecting_configs(robot: Any, q: FloatArray) -> list[str | None]:
         near = np.max(np.abs(found[rows] - q[rows][:, None, :]), axis=-1) < CONFIG_TOLERANCE
         selected[rows] = np.any(ok, axis=-1) & np.all(~ok | near, axis=-1)
     return [c if keep else None for c, keep in zip(configs, selected, strict=True)]
+
+
+_ARM_JOINTS = (1, 2)
+"""J2, J3 (0-based): the only controller joints the shoulder and elbow flags read (the wrist
+centre in the frame turning with J1 and the forearm angle), given a coupling that maps them
+onto model J2, J3 alone (:func:`_flags_follow_j2_j3`)."""
+
+
+def _flags_follow_j2_j3(robot: Any) -> bool:
+    """Whether the robot's joint coupling feeds model J2 and J3 from controller J2 and J3 only
+    (identity or Fanuc's J3 + J2), the premise of :func:`_selecting_configs`."""
+    coupling = getattr(getattr(robot, "kinematics", None), "coupling", None)
+    matrix = getattr(coupling, "matrix", None)
+    if matrix is None:
+        return False
+    rows = np.asarray(matrix)[list(_ARM_JOINTS)]
+    others = [j for j in range(rows.shape[1]) if j not in _ARM_JOINTS]
+    return bool(np.all(rows[:, others] == 0))
+
+
+def _selecting_configs(robot: Any, q: FloatArray) -> list[str | None]:
+    """:func:`selecting_configs` of one batch (n, 6) rad, equal result for result to
+    :func:`_selecting_configs_reference` (tests/vendors/test_fanuc_selection.py).
+
+    Proof (joints numbered J1..J6 as on the pendant). The reference builds, per point and IK
+    branch ``b`` (wrapped as in :func:`~olp.kinematics.base.turn_variants`), the candidates
+    ``c = base_b + s`` for every shift vector ``s`` in the product ``S_1 x ... x S_6`` of
+    per-joint turn shifts (NaN outside the limits), and decides
+    ``selected = any(ok) & all(~ok | near)``, where ``ok(c)`` is a conjunction of
+
+    * inside the limits: ``lo_j - tol <= c_j <= hi_j + tol`` for each joint ``j`` (NaN fails);
+    * the turn ranges of J1, J4, J6 and the J5 sign test of ``satisfies``: one joint each;
+    * the shoulder test on ``wrist_x(c)`` and the elbow test on ``elbow_angle(c)``,
+
+    and ``near(c) = max_j |c_j - q_j| < CONFIG_TOLERANCE`` (on rows inside the limits, which
+    are finite, this is ``all_j |c_j - q_j| < CONFIG_TOLERANCE``). Every test but the shoulder
+    and elbow ones reads one joint ``c_j = base_bj + s_j``, the same float sum the reference
+    forms, compared with the same float bounds: so ``ok = XE(c_2, c_3) · prod_j A_j(c_j)`` and
+    ``near = prod_j N_j(c_j)`` with per-joint masks ``A_j``, ``N_j`` that equal the reference's
+    bit for bit. The shoulder and elbow values read model J2 and J3 only (``_arm_x_z``,
+    :func:`~olp.kinematics.configuration.elbow_angle`), which the coupling feeds from
+    controller J2 and J3 alone (:func:`_flags_follow_j2_j3`; the matrix product adds the
+    other joints times an exact 0, which leaves every float unchanged for finite joints), so
+    ``XE`` is evaluated once per (J2, J3) shift pair, on the same joint values, by the same
+    functions (numpy's elementwise functions give an element the same value whatever array it
+    sits in), and only where ``A_2 A_3`` holds and every other joint has a passing shift
+    (:func:`_arm_flags_pass`; elsewhere a factor below is 0 whatever ``XE`` is). Then, per
+    branch, the number of candidates that are ``ok`` is
+    ``sum_{s2,s3} A_2 A_3 XE · prod_{j != 2,3} sum_s A_j`` and the number that are ``ok`` and
+    ``near`` the same with ``A_j N_j`` in place of ``A_j``; ``any(ok)`` is "the first count is
+    positive" and ``all(~ok | near)`` is "the two counts are equal" (near-and-ok candidates
+    are a subset of the ok ones). No step rounds differently, so no margin is needed: the
+    result is the reference's, for every point, without the per-point candidate rows.
+    """
+    from olp.kinematics.base import turn_shifts, wrap_joints
+    from olp.kinematics.configuration import TOLERANCE
+
+    flags = branch_flags(robot, q)
+    configs = _config_texts(q, flags)
+    lower = np.asarray(robot.limits.lower, dtype=np.float64)
+    upper = np.asarray(robot.limits.upper, dtype=np.float64)
+    base = wrap_joints(robot.solve(robot.flange_poses(q)))  # (n, B, 6)
+    inside_lo, inside_hi = lower - _VARIANT_TOLERANCE, upper + _VARIANT_TOLERANCE
+    bounds = _turn_bounds(q)
+    values, ok, near = [], [], []
+    for j in range(6):
+        v = base[..., j, None] + np.asarray(turn_shifts(lower[j], upper[j]))  # (n, B, k_j)
+        with np.errstate(invalid="ignore"):
+            a = (v >= inside_lo[j]) & (v <= inside_hi[j])
+            if j in bounds:
+                low, high = bounds[j]
+                a &= (v >= low - TOLERANCE) & (v <= high + TOLERANCE)
+            if j == 4:
+                a &= np.where(flags.flip[:, None, None], v <= TOLERANCE, v >= -TOLERANCE)
+            n = np.abs(v - q[:, None, None, j]) < CONFIG_TOLERANCE
+        values.append(v)
+        ok.append(a)
+        near.append(a & n)
+    xe = _arm_flags_pass(robot, flags, base, values, ok)
+    count_ok = _count(ok, xe)
+    count_near = _count(near, xe)
+    selected = (count_ok.sum(axis=-1) > 0) & (count_ok.sum(axis=-1) == count_near.sum(axis=-1))
+    return [c if keep else None for c, keep in zip(configs, selected.tolist(), strict=True)]
+
+
+_VARIANT_TOLERANCE = 1e-9
+"""rad: the limit slack of :func:`olp.kinematics.base.turn_variants` (its default)."""
+
+
+def _turn_bounds(q: FloatArray) -> dict[int, tuple[FloatArray, FloatArray]]:
+    """Per turn axis, the bounds (n, 1, 1) rad of the turn range each joint vector (n, 6) asks
+    for: :func:`turn_range` of its :func:`turn_number`, as the same float products."""
+    turns = turn_number(q[:, list(TURN_AXES)])
+    out: dict[int, tuple[FloatArray, FloatArray]] = {}
+    for k, axis in enumerate(TURN_AXES):
+        t = turns[:, k, None, None]
+        low: FloatArray = np.asarray((2 * t - 1) * math.pi, dtype=np.float64)
+        high: FloatArray = np.asarray((2 * t + 1) * math.pi, dtype=np.float64)
+        out[axis] = (low, high)
+    return out
+
+
+def _arm_flags_pass(
+    robot: Any, flags: Any, base: FloatArray, values: list[FloatArray], ok: list[NDArray[np.bool_]]
+) -> NDArray[np.bool_]:
+    """The shoulder and elbow tests of ``satisfies`` (n, B, k_2, k_3) per point, branch and
+    (J2, J3) shift pair, evaluated where they can change a count of :func:`_count`: where the
+    J2 and J3 values pass their own joint masks ``ok`` and every other joint has a passing
+    shift (elsewhere False, which leaves the counts unchanged because a factor is 0 there).
+
+    ``base`` (n, B, 6): the wrapped IK solutions; ``values[j]`` (n, B, k_j): joint j's shifted
+    values; ``flags``: the planned joints' :class:`~olp.kinematics.configuration.BranchFlags`.
+    """
+    from olp.kinematics.configuration import TOLERANCE, elbow_angle, wrist_x
+
+    j2, j3 = _ARM_JOINTS
+    others = np.ones(base.shape[:2], dtype=bool)
+    for j, mask in enumerate(ok):
+        if j not in _ARM_JOINTS:
+            others &= _count_last(mask) > 0
+    wanted = ok[j2][..., :, None] & ok[j3][..., None, :] & others[..., None, None]
+    i, b, m2, m3 = np.nonzero(wanted)
+    rows = base[i, b]  # the other joints' values leave both tests unchanged (see the proof)
+    rows[:, j2] = values[j2][i, b, m2]
+    rows[:, j3] = values[j3][i, b, m3]
+    x, e = wrist_x(robot, rows), elbow_angle(robot, rows)
+    passed = np.where(flags.back[i], x <= TOLERANCE, x >= -TOLERANCE)
+    passed &= np.where(flags.down[i], e <= TOLERANCE, e >= -TOLERANCE)
+    out = np.zeros(wanted.shape, dtype=bool)
+    out[i, b, m2, m3] = passed
+    return out
+
+
+def _count(masks: list[NDArray[np.bool_]], xe: NDArray[np.bool_]) -> IntArray:
+    """Per point and branch (n, B), the candidates passing per-joint ``masks`` (n, B, k_j) and
+    the shoulder/elbow mask ``xe`` (n, B, k_2, k_3) over J2, J3 shift pairs."""
+    j2, j3 = _ARM_JOINTS
+    pairs = masks[j2][..., :, None] & masks[j3][..., None, :] & xe
+    count = _count_last(pairs.reshape(*pairs.shape[:-2], -1))
+    for j, mask in enumerate(masks):
+        if j not in _ARM_JOINTS:
+            count *= _count_last(mask)
+    return count
+
+
+def _count_last(mask: NDArray[np.bool_]) -> IntArray:
+    """True entries along the last, short axis (a few turn shifts) of ``mask``: slice sums,
+    because a numpy reduction over an axis of length 2 or 3 costs ~10x more."""
+    count = np.zeros(mask.shape[:-1], dtype=np.int64)
+    for k in range(mask.shape[-1]):
+        count += mask[..., k]
+    return count

@@ -668,3 +668,40 @@ def test_a_speed_too_slow_for_ls_is_written_at_its_least_with_a_warning() -> Non
     assert raised == [(0, "warning"), (1, "warning")]
     body = result.files["SLOW.ls"]
     assert "J P[1] 1% FINE" in body and "L P[2] 1mm/sec FINE" in body
+
+
+def _weld_robot() -> Any:
+    cell = Path(__file__).resolve().parents[2] / "stations" / "fanuc_m20ia_weld_cell.yaml"
+    return olp.load_station(cell).robot
+
+
+def test_remembered_selections_are_the_selections_of_the_same_rows() -> None:
+    robot = _weld_robot()
+    rng = np.random.default_rng(5)
+    q = rng.uniform(robot.limits.lower, robot.limits.upper, size=(400, 6))
+    q[::3, 4] = 0.0  # some rows are written as joints (None)
+    direct = fanuc.selecting_configs(robot, q)
+    post = find_post("fanuc")
+    assert post.selecting_configs(robot, q[:150]) == direct[:150]
+    # Known rows shuffled, repeated and mixed with unknown ones, and -0.0 as a different row.
+    order = rng.permutation(np.r_[np.arange(400), np.arange(100)])
+    assert post.selecting_configs(robot, q[order]) == [direct[k] for k in order]
+    signed = q[:5].copy()
+    signed[:, 4] = -0.0
+    assert post.selecting_configs(robot, signed) == fanuc.selecting_configs(robot, signed)
+
+
+def test_a_hash_collision_in_the_memo_is_a_miss_not_another_rows_selection(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    from olp.posts import fanuc as fanuc_post
+
+    robot = _weld_robot()
+    q = np.random.default_rng(6).uniform(robot.limits.lower, robot.limits.upper, size=(60, 6))
+    q[::2, 4] = 0.0
+    monkeypatch.setattr(fanuc_post, "_row_hashes", lambda bits: np.zeros(len(bits), np.uint64))
+    post = find_post("fanuc")
+    direct = fanuc.selecting_configs(robot, q)
+    assert post.selecting_configs(robot, q[:30]) == direct[:30]
+    assert post.selecting_configs(robot, q) == direct
+    assert post.selecting_configs(robot, q[::-1]) == direct[::-1]
