@@ -651,11 +651,25 @@ class Names:
         if (
             len(folded) == len(wanted)
             and folded.isdisjoint(self.taken)
-            and all(self._legal_as_is(w) for w in wanted)
+            and self._all_legal_as_is(wanted)
         ):
             self.taken |= folded
             return list(wanted)
         return [self.take(w) for w in wanted]
+
+    def _all_legal_as_is(self, names: Sequence[str]) -> bool:
+        """:meth:`_legal_as_is` of every name, checked on the names joined by line breaks."""
+        if not names:
+            return True
+        rule = self.rule
+        joined = "\n".join(names)
+        compared = names if rule.case_sensitive else [n.upper() for n in names]
+        return (
+            _PLAIN_NAMES.fullmatch(joined) is not None
+            and (not rule.upper or joined == joined.upper())
+            and (rule.max_length is None or max(map(len, names)) <= rule.max_length)
+            and rule.reserved.isdisjoint(compared)
+        )
 
     def _legal_as_is(self, name: str) -> bool:
         """Whether ``rule.legal(name)`` is ``name`` itself, without building it (a point name
@@ -671,6 +685,7 @@ class Names:
 
 
 _PLAIN_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
+_PLAIN_NAMES = re.compile(r"[A-Za-z][A-Za-z0-9_]*(?:\n[A-Za-z][A-Za-z0-9_]*)*")
 
 
 class Modal:
