@@ -8,6 +8,13 @@ and writes its lines in Python, formatting the numbers of the run column by colu
 (:meth:`olp.posts.base.Post.number_column`). The text is the same, byte for byte, as the
 template's for the same moves (``tests/posts/test_rows.py`` renders both ways); headers, data
 sections and every other instruction stay templates.
+
+A post whose row writer also takes columns (:attr:`olp.posts.base.Post.COLUMNS`) gets a dense
+toolpath's rows without any object per row: one :class:`~olp.posts.view.RowColumns` item per
+block (or per piece of a block in a split program) holding the block's arrays, its change flags
+computed over them; numbers are spelled and checked as whole columns (:func:`number_column`,
+exactly as :func:`olp.posts.numbers.format_number` spells each:
+``tests/posts/test_row_columns.py``).
 """
 
 from __future__ import annotations
