@@ -146,8 +146,9 @@ def build(
     diagnostics = notes + compiled.diagnostics
     if not compiled.ok:
         return BuildResult(compiled, writer.name, diagnostics)
-    # The post walks the steps several times: a toolpath's rows are made into steps once here.
-    compiled, prepared = writer.prepare(compiled.flat())
+    # The post walks the steps several times: a toolpath's rows are made into steps once here,
+    # unless its row writer takes them as columns (Post.render_form).
+    compiled, prepared = writer.prepare(writer.render_form(compiled))
     diagnostics = diagnostics + tuple(prepared) + tuple(writer.check(compiled))
     if has_errors(diagnostics):
         return BuildResult(compiled, writer.name, diagnostics)

@@ -145,6 +145,51 @@ class PathBlock:
         )
 
 
+@dataclass(frozen=True, slots=True, eq=False)
+class BlockRows:
+    """Rows ``lo`` to ``hi`` (exclusive) of a :class:`PathBlock`: the piece of a toolpath that
+    one file of a split program writes, without a :class:`Step` per row."""
+
+    block: PathBlock
+    lo: int
+    hi: int
+    skipped: bool = False
+
+    @property
+    def index(self) -> int:
+        """The instruction index of the first row."""
+        return self.block.start + self.lo
+
+    def __len__(self) -> int:
+        return self.hi - self.lo
+
+
+def pieces(
+    items: Sequence[Item], bounds: Sequence[tuple[int, int]]
+) -> list[list[Step | BlockRows]]:
+    """The steps and block rows of each half-open instruction range ``bounds[k]`` (in order,
+    covering ``items``): a block cut by a bound is two :class:`BlockRows`."""
+    out: list[list[Step | BlockRows]] = []
+    k = 0
+    for a, b in bounds:
+        part: list[Step | BlockRows] = []
+        while k < len(items):
+            item = items[k]
+            if isinstance(item, PathBlock):
+                lo, hi = max(a, item.start), min(b, item.stop)
+                if lo < hi:
+                    part.append(BlockRows(item, lo - item.start, hi - item.start))
+                if item.stop > b:
+                    break
+            elif item.index < b:
+                part.append(item)
+            else:
+                break
+            k += 1
+        out.append(part)
+    return out
+
+
 class RowTrajectories:
     """The time laws of a block's rows: row ``k`` is :meth:`segment` ``(k)``, the window
     ``start[k]..end[k]`` (s) of law ``laws[law[k]]`` (several rows share one law where they are

@@ -64,10 +64,10 @@ from olp.posts.text import (
 )
 
 if TYPE_CHECKING:
-    from olp.compiled import CompiledProgram, Step
+    from olp.compiled import CompiledProgram, PathBlock, Step
     from olp.posts.manifest import PostManifest
     from olp.posts.rows import PostRows
-    from olp.posts.view import PostStep
+    from olp.posts.view import PostStep, RowColumns
 
 FloatArray = NDArray[np.float64]
 
@@ -173,9 +173,14 @@ class Post:
     """Whether the post writes runs of linear moves with a row writer (:mod:`olp.posts.rows`);
     used only where the template folder says ``rows: true`` and :meth:`rows_enabled` agrees."""
 
+    COLUMNS: ClassVar[bool] = False
+    """Whether the row writer also takes a toolpath's rows as columns
+    (:class:`~olp.posts.view.RowColumns`): a toolpath is then written without a step per row
+    (:meth:`columns_enabled`)."""
+
     def __init__(self, manifest: PostManifest) -> None:
         self.manifest = manifest
-        self.current_step: PostStep | PostRows | None = None
+        self.current_step: PostStep | PostRows | RowColumns | None = None
         self.problems: list[Diagnostic] = []
         self.collecting = False
         """While rendering: numbers that cannot be written are collected as diagnostics on the
@@ -196,6 +201,13 @@ class Post:
         """Per motion, from its planned joints ``(N, dof)`` rad: values the templates need
         (KUKA Status/Turn, ABB confdata), as ``PostStep.vendor``."""
         return [{} for _ in range(joints.shape[0])]
+
+    def step_columns(self, robot: Any, joints: FloatArray) -> Mapping[str, Any]:
+        """:meth:`step_values` of a toolpath's rows ``(N, dof)`` rad as columns: ``{key:
+        array (N,)}`` (a brand with a column writer computes them as arrays)."""
+        values = self.step_values(robot, joints)
+        keys = values[0].keys() if values else ()
+        return {key: np.array([v[key] for v in values]) for key in keys}
 
     def context_values(self, steps: Sequence[PostStep]) -> Mapping[str, Any]:
         """Per file: the ``vendor`` context entry (e.g. ABB's custom speed data)."""
@@ -230,11 +242,40 @@ class Post:
         out = self._foreign_robot(compiled)
         if compiled.program.has_flow and not (self.WRITES_FLOW and self.manifest.flow):
             return [*out, self._flow_error(compiled)]
-        compiled = compiled.flat()
-        for step in compiled.steps:
-            out += self._shared_checks(step)
-            out += self.check_instruction(step, compiled)
+        from olp.compiled import PathBlock, items_of
+
+        compiled = self.render_form(compiled)
+        for item in items_of(compiled.steps):
+            if isinstance(item, PathBlock):
+                out += self.check_block(item, compiled)
+                continue
+            out += self._shared_checks(item)
+            out += self.check_instruction(item, compiled)
         return out + self._acceleration_checks(compiled.steps) + self.check_program(compiled)
+
+    def check_block(self, block: PathBlock, compiled: CompiledProgram) -> list[Diagnostic]:
+        """:meth:`check` of a toolpath's rows (linear moves to Cartesian targets, one tool
+        and frame): what the shared checks say of a linear move, and :meth:`check_rows`."""
+        if "linear" not in self.KINDS:
+            return [f for step in block.steps() for f in self._shared_checks(step)]
+        return self.check_rows(block, compiled)
+
+    def check_rows(self, block: PathBlock, compiled: CompiledProgram) -> list[Diagnostic]:
+        """:meth:`check_instruction` of a toolpath's rows; row by row unless a brand says
+        what it checks of them as arrays."""
+        return [f for step in block.steps() for f in self.check_instruction(step, compiled)]
+
+    def columns_enabled(self, compiled: CompiledProgram) -> bool:
+        """Whether a toolpath's rows go to the column writer without a step per row: the
+        post has one (:attr:`COLUMNS`), rows are enabled, and the program has no control flow
+        (which is woven into the steps one by one)."""
+        return self.COLUMNS and self.rows_enabled() and not compiled.program.has_flow
+
+    def render_form(self, compiled: CompiledProgram) -> CompiledProgram:
+        """``compiled`` as :meth:`render` walks it: toolpath blocks kept as arrays where
+        :meth:`columns_enabled`, else made into steps once (the templates walk them several
+        times)."""
+        return compiled if self.columns_enabled(compiled) else compiled.flat()
 
     def _acceleration_checks(self, steps: Sequence[Step]) -> list[Diagnostic]:
         """One warning per acceleration limit the program sets on path moves and this
@@ -243,17 +284,12 @@ class Post:
         for name in ("linear_acceleration", "angular_acceleration"):
             if name in self.ACCELERATIONS and self.manifest.accelerations:
                 continue
-            moves = [
-                step
-                for step in steps
-                if step.instruction.kind in ("linear", "circular")
-                and getattr(step.instruction.speed, name) is not None
-            ]
-            if moves:
+            count, first = _setting(steps, name)
+            if first is not None:
                 what = _ACCELERATION_NAMES[name]
                 msg = (
                     f"the {self.LANGUAGE} post cannot write the {what} set on "
-                    f"{len(moves)} path move(s): the controller's own applies, and the cycle "
+                    f"{count} path move(s): the controller's own applies, and the cycle "
                     "time differs from the estimate"
                 )
                 if name in self.ACCELERATIONS:
@@ -262,7 +298,7 @@ class Post:
                         "accelerations: true; a copy of an older post: copy the bundled "
                         "templates' acceleration lines and declare it)"
                     )
-                out.append(_warning("acceleration", msg, moves[0]))
+                out.append(_warning("acceleration", msg, first))
         return out
 
     def render(
@@ -276,8 +312,7 @@ class Post:
 
         if not prepared:
             compiled = self.prepare(compiled)[0]
-        # The templates walk the steps row by row several times: make a toolpath's rows once.
-        return render(compiled.flat(), self, name)
+        return render(self.render_form(compiled), self, name)
 
     def write(self, files: Mapping[str, str], folder: Path) -> list[Path]:
         """Encode every file in the manifest's encoding (a character it lacks is a PostError
@@ -332,12 +367,35 @@ class Post:
         self.current_step = saved
         return out
 
+    def number_texts(
+        self, quantity: str, values: Any, at: Callable[[int], PostStep]
+    ) -> NDArray[np.str_]:
+        """:meth:`number` of values (n, k) or (n,) as an array of texts of the same shape,
+        spelled and checked as columns (:func:`olp.posts.rows.number_column`); row r is
+        ``at(r)``'s: a value that cannot be written is an error on that row's instruction."""
+        from olp.posts.rows import number_column
+
+        v = np.asarray(values, dtype=np.float64)
+        fmt = self.NUMBERS[quantity]
+        texts, ok = number_column(v, fmt)
+        if ok:
+            return texts.reshape(v.shape)
+        saved, out = self.current_step, []
+        per_row = v.reshape(v.shape[0], -1) if v.ndim else v.reshape(1, 1)
+        for r, row in enumerate(per_row):
+            self.current_step = at(r)
+            out += [self.number_with(fmt, float(x)) for x in row]
+        self.current_step = saved
+        return np.array(out, dtype=np.str_).reshape(v.shape)
+
     def rows_enabled(self) -> bool:
         """Whether runs of linear moves go to the row writer: the post has one, the template
         folder declares ``rows: true``, and (per brand) the options allow it."""
         return self.ROWS and self.manifest.rows
 
-    def group(self, steps: Sequence[PostStep]) -> list[PostStep | PostRows]:
+    def group(
+        self, steps: Sequence[PostStep | RowColumns]
+    ) -> list[PostStep | PostRows | RowColumns]:
         """A file's steps as its templates see them (:func:`olp.posts.rows.group_rows` where
         :meth:`rows_enabled`)."""
         from olp.posts.rows import group_rows
@@ -548,6 +606,33 @@ _ACCELERATION_NAMES = {
     "linear_acceleration": "TCP path acceleration",
     "angular_acceleration": "orientation acceleration",
 }
+
+
+def _setting(steps: Sequence[Step], name: str) -> tuple[int, Step | None]:
+    """How many path moves of ``steps`` set the :class:`~olp.ir.Speed` limit ``name``, and the
+    first (a toolpath's rows counted from its arrays)."""
+    from olp.compiled import PathBlock, items_of
+
+    count, first = 0, None
+    for item in items_of(steps):
+        if isinstance(item, PathBlock):
+            if getattr(item.node, _NODE_LIMITS[name]) is not None:
+                count += len(item)
+                first = first or item.step(0)
+        elif (
+            item.instruction.kind in ("linear", "circular")
+            and getattr(item.instruction.speed, name) is not None
+        ):
+            count += 1
+            first = first or item
+    return count, first
+
+
+_NODE_LIMITS = {
+    "linear_acceleration": "acceleration",
+    "angular_acceleration": "angular_acceleration",
+}
+"""The :class:`~olp.ir.LinearPath` field of each acceleration limit of its rows."""
 
 
 def _error(kind: str, message: str, step: Step, hint: str | None = None) -> Diagnostic:

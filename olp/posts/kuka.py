@@ -52,7 +52,7 @@ from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from olp.diagnostics import Diagnostic
 from olp.errors import PostError
@@ -63,10 +63,11 @@ from olp.posts.kuka_flow import EVENT_KINDS, flow_problem, krl_decl, krl_event, 
 from olp.posts.numbers import NumberFormat, Storage
 from olp.posts.sandbox import SafeText
 from olp.posts.text import IDENTIFIER, NUMBER, ArgumentRule, NameRule, double_quoted, one_of
+from olp.posts.view import RowColumns
 from olp.vendors.kuka import ARC_TYPES, pose_to_frame, status_turn, turn_ambiguous
 
 if TYPE_CHECKING:
-    from olp.compiled import CompiledProgram, Step
+    from olp.compiled import CompiledProgram, PathBlock, Step
     from olp.posts.rows import PostRows
     from olp.posts.view import Modal, PostStep
 
@@ -221,7 +222,9 @@ def krl_ca(post: Post, step: PostStep) -> str:
     return "" if angle is None else f", CA {post.number('angle', math.degrees(angle))}"
 
 
-def krl_rows(post: Post, rows: PostRows, modal: Modal, arcs_written: bool = False) -> SafeText:
+def krl_rows(
+    post: Post, rows: PostRows | RowColumns, modal: Modal, arcs_written: bool = False
+) -> SafeText:
     """The lines of a run of LINs (:mod:`olp.posts.rows`), exactly as ``program.src.j2`` writes
     each (inline points): ``$BASE``/``$TOOL`` where they change, ``$VEL.CP`` (and ``$VEL.ORI``,
     ``$ACC.CP``, ``$ACC.ORI1`` where set) where the speed changes, ``$APO.CDIS`` where the
@@ -229,6 +232,8 @@ def krl_rows(post: Post, rows: PostRows, modal: Modal, arcs_written: bool = Fals
     ``$ORI_TYPE = #VAR`` after an arc (``arcs_written``), then ``LIN {E6POS} [C_DIS]``. The
     targets' numbers are formatted as columns. Every piece is a checked number, a legal name or
     a keyword, so the lines are :class:`~olp.posts.sandbox.SafeText`."""
+    if isinstance(rows, RowColumns):
+        return SafeText(_column_lines(post, rows, modal, arcs_written))
     steps = rows.steps
     named = post.options.get("points", "inline") == "dat"
     targets = [s.name for s in steps] if named else [f"{{{t}}}" for t in _e6pos_texts(post, rows)]
@@ -261,9 +266,13 @@ def krl_rows(post: Post, rows: PostRows, modal: Modal, arcs_written: bool = Fals
     return SafeText("\n".join(lines))
 
 
-def krl_rows_dat(post: Post, rows: PostRows) -> SafeText:
+def krl_rows_dat(post: Post, rows: PostRows | RowColumns) -> SafeText:
     """The .dat declarations of a run of LINs with named points (``points: dat``), exactly as
     ``program.dat.j2`` writes each: ``DECL E6POS XP12={X ..,S ..,T ..}``."""
+    if isinstance(rows, RowColumns):
+        decl = np.strings.add(np.strings.add("DECL E6POS ", np.asarray(rows.names)), "={")
+        decls = np.strings.add(np.strings.add(decl, _e6pos_column(post, rows)), "}")
+        return SafeText("\n".join(decls.tolist()))
     texts = _e6pos_texts(post, rows)
     lines = [f"DECL E6POS {s.name}={{{t}}}" for s, t in zip(rows.steps, texts, strict=True)]
     return SafeText("\n".join(lines))
@@ -282,6 +291,98 @@ def _e6pos_texts(post: Post, rows: PostRows) -> list[str]:
             f"X {xyz[p]},Y {xyz[p + 1]},Z {xyz[p + 2]},A {abc[p]},B {abc[p + 1]},C {abc[p + 2]}"
             f",S {int(step.vendor['status'])},T {int(step.vendor['turn'])}"
         )
+    return out
+
+
+def _e6pos_column(post: Post, rows: RowColumns) -> NDArray[np.str_]:
+    """Each row's E6POS without braces (:func:`krl_e6pos`), formatted as columns."""
+    frames = pose_to_frame(rows.poses)
+    xyz = post.number_texts("position", frames[:, :3], rows.at)
+    abc = post.number_texts("angle", frames[:, 3:], rows.at)
+    out = np.strings.add("X ", xyz[:, 0])
+    for label, column in ((",Y ", xyz[:, 1]), (",Z ", xyz[:, 2]), (",A ", abc[:, 0])):
+        out = np.strings.add(np.strings.add(out, label), column)
+    for label, column in ((",B ", abc[:, 1]), (",C ", abc[:, 2])):
+        out = np.strings.add(np.strings.add(out, label), column)
+    for label, key in ((",S ", "status"), (",T ", "turn")):
+        out = np.strings.add(np.strings.add(out, label), _integer_texts(rows.column(key)))
+    return out
+
+
+def _integer_texts(values: NDArray[Any]) -> NDArray[np.str_]:
+    return np.asarray(values, dtype=np.int64).astype(np.str_)
+
+
+def _column_lines(post: Post, rows: RowColumns, modal: Modal, arcs_written: bool) -> str:
+    """:func:`krl_rows` of a toolpath's rows as columns: the ``LIN`` lines as arrays, and
+    before each row the lines it changes (modal state tracked over the arrays)."""
+    n = len(rows)
+    at = rows.at
+    if post.options.get("points", "inline") == "dat":
+        targets = np.asarray(rows.names, dtype=np.str_)
+    else:
+        targets = np.strings.add(np.strings.add("{", _e6pos_column(post, rows)), "}")
+    zones = rows.zones
+    fine = zones == 0.0
+    lin = np.strings.add("LIN ", targets)
+    lin = np.where(fine, lin, np.strings.add(lin, " C_DIS"))
+    before = np.full(n, "", dtype=np.str_)
+
+    def add(where: NDArray[np.intp], texts: NDArray[np.str_]) -> None:
+        nonlocal before
+        if where.size:
+            longer = np.strings.add(np.strings.add(before[where], texts), "\n")
+            before = before.astype(np.result_type(before.dtype, longer.dtype))
+            before[where] = longer
+
+    node = rows.node
+    changed = np.flatnonzero(rows.new_linear_speed)
+    if changed.size:
+        at_changed = lambda j: at(int(changed[j]))  # noqa: E731
+        same = np.ones(changed.size)
+        vel = post.number_texts("vel_cp", rows.speeds[changed], at_changed)
+        add(changed, np.strings.add("$VEL.CP = ", vel))
+        if node.angular is not None:
+            ori = post.number_texts("vel_ori", same * math.degrees(node.angular), at_changed)
+            ori1 = np.strings.add(np.strings.add("$VEL.ORI1 = ", ori), "\n$VEL.ORI2 = ")
+            add(changed, np.strings.add(ori1, ori))
+        if node.acceleration is not None:
+            acc = post.number_texts("acc_cp", same * node.acceleration, at_changed)
+            add(changed, np.strings.add("$ACC.CP = ", acc))
+        if node.angular_acceleration is not None:
+            value = math.degrees(node.angular_acceleration)
+            acc_ori = post.number_texts("acc_ori", same * value, at_changed)
+            add(changed, np.strings.add("$ACC.ORI1 = ", acc_ori))
+    blended = np.flatnonzero(~fine)
+    if blended.size:
+        radii = zones[blended]
+        new = np.empty(blended.size, dtype=bool)
+        new[0] = modal.changed("cdis", float(radii[0]))
+        new[1:] = radii[1:] != radii[:-1]
+        modal.changed("cdis", float(radii[-1]))
+        where = blended[new]
+        cdis = post.number_texts("cdis", zones[where] * 1000, lambda j: at(int(where[j])))
+        add(where, np.strings.add("$APO.CDIS = ", cdis))
+    if arcs_written and modal.changed("ori_type", "VAR"):
+        add(np.zeros(1, dtype=np.intp), np.array(["$ORI_TYPE = #VAR"]))
+    head = _head_lines(post, rows)
+    post.current_step = rows
+    lines = np.strings.add(before, lin).tolist()
+    return "\n".join([*head, *lines])
+
+
+def _head_lines(post: Post, rows: RowColumns) -> list[str]:
+    """``$BASE`` / ``$TOOL`` before the first row, where they change."""
+    if not (rows.new_frame or rows.new_tool):
+        return []
+    mode = str(post.options.get("frames", "inline"))
+    step = rows.at(0)
+    post.current_step = step
+    out = []
+    if step.new_frame:
+        out.append(f"$BASE = {krl_base(post, step, mode)} ; {step.frame_name}")
+    if step.new_tool:
+        out.append(f"$TOOL = {krl_tool(post, step, mode)} ; {step.tool_name}")
     return out
 
 
@@ -354,6 +455,22 @@ class KukaPost(Post):
     ARC_ORIENTATIONS = frozenset(ARC_TYPES) - {ArcOrientation.WRIST}
     ARC_ANGLE = True
     ROWS = True
+    COLUMNS = True
+
+    def step_columns(self, robot: Any, joints: Any) -> Mapping[str, Any]:
+        """:meth:`step_values` as arrays (N,)."""
+        q = np.asarray(joints, dtype=np.float64)
+        try:
+            status, turn = status_turn(robot, q)
+        except (TypeError, ValueError) as exc:
+            raise PostError(f"the KRL post cannot describe robot {robot.name!r}: {exc}") from exc
+        limits = robot.limits
+        ambiguous = turn_ambiguous(q, limits.lower, limits.upper)
+        return {"status": status, "turn": turn, "turn_ambiguous": ambiguous}
+
+    def check_rows(self, block: PathBlock, compiled: CompiledProgram) -> list[Diagnostic]:
+        """Nothing: :meth:`check_instruction` checks joint moves only."""
+        return []
 
     def step_values(self, robot: Any, joints: Any) -> list[Mapping[str, Any]]:
         """Status and Turn of each motion's planned joints (N, 6) rad, and whether Turn cannot

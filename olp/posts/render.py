@@ -49,13 +49,24 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from olp import progress
+from olp.compiled import BlockRows, PathBlock, StepBlocks, items_of, pieces
 from olp.diagnostics import Diagnostic
 from olp.errors import PostError
+from olp.ir import is_motion
 from olp.posts.flow import weave
 from olp.posts.rows import PostRows
 from olp.posts.text import basename
-from olp.posts.view import Allocation, Modal, Names, PostFrame, PostStep, PostTool, ProgramView
-from olp.transforms.split import SplitLimits, part_names, split_steps
+from olp.posts.view import (
+    Allocation,
+    Modal,
+    Names,
+    PostFrame,
+    PostStep,
+    PostTool,
+    ProgramView,
+    RowColumns,
+)
+from olp.transforms.split import SplitLimits, part_names, split_bounds, split_steps
 
 if TYPE_CHECKING:
     from olp.compiled import CompiledProgram, Step
@@ -70,14 +81,14 @@ class RenderError(Exception):
         self.diagnostics = tuple(diagnostics)
 
 
-class TrackedSteps(list[PostStep | PostRows]):
+class TrackedSteps(list[PostStep | PostRows | RowColumns]):
     """A file's steps; iterating them tells the post which instruction is being written."""
 
-    def __init__(self, steps: Sequence[PostStep | PostRows], post: Post) -> None:
+    def __init__(self, steps: Sequence[PostStep | PostRows | RowColumns], post: Post) -> None:
         super().__init__(steps)
         self.post = post
 
-    def __iter__(self) -> Iterator[PostStep | PostRows]:
+    def __iter__(self) -> Iterator[PostStep | PostRows | RowColumns]:
         for step in super().__iter__():
             self.post.current_step = step
             yield step
@@ -100,7 +111,7 @@ def render(compiled: CompiledProgram, post: Post, name: str | None = None) -> di
     renderer = _Renderer(compiled, post, name)
     limits = manifest.limits
     for _ in range(_MAX_SPLIT_ROUNDS):
-        parts = split_steps(compiled.steps, limits)
+        parts = _split(compiled.steps, limits)
         if len(parts) > 1 and compiled.program.has_flow:
             raise RenderError([_no_split(compiled, len(parts))])
         post.problems, post.collecting = [], True
@@ -115,6 +126,32 @@ def render(compiled: CompiledProgram, post: Post, name: str | None = None) -> di
             return files
         limits = _finer(limits, parts, lines, manifest.limits.max_lines, longest, renderer)
     raise PostError(f"post {manifest.name!r}: could not meet max_lines_per_file by splitting")
+
+
+Part = Sequence["Step | BlockRows"]
+"""One file's instructions: steps, and rows of toolpath blocks."""
+
+
+def _split(steps: Sequence[Step], limits: SplitLimits) -> list[Part]:
+    """:func:`~olp.transforms.split.split_steps` of ``steps``; a toolpath's rows stay rows of
+    its block (:class:`~olp.compiled.BlockRows`), no step made per row."""
+    if not isinstance(steps, StepBlocks):
+        return list(split_steps(steps, limits))
+    motions: list[bool] = []
+    written: list[bool] = []
+    for item in steps.blocks:
+        if isinstance(item, PathBlock):
+            motions += [True] * len(item)
+            written += [True] * len(item)
+        else:
+            motions.append(is_motion(item.instruction))
+            written.append(not item.skipped)
+    return list(pieces(steps.blocks, split_bounds(motions, written, limits)))
+
+
+def _count(part: Part) -> int:
+    """The instructions of ``part`` that are written."""
+    return sum(len(s) if isinstance(s, BlockRows) else int(not s.skipped) for s in part)
 
 
 def _no_split(compiled: CompiledProgram, parts: int) -> Diagnostic:
@@ -145,14 +182,14 @@ def _longest(files: Mapping[str, str], ending: str) -> tuple[str, int]:
 
 def _finer(
     limits: SplitLimits,
-    parts: list[tuple[Step, ...]],
+    parts: list[Part],
     lines: int,
     max_lines: int,
     longest: str,
     renderer: _Renderer,
 ) -> SplitLimits:
     """Tighter instruction limits after a file came out with ``lines`` > ``max_lines``."""
-    biggest = max(sum(1 for s in p if not s.skipped) for p in parts)
+    biggest = max(_count(p) for p in parts)
     if longest in renderer.main_file_names or biggest <= 1:
         raise PostError(
             f"post {renderer.manifest.name!r}: {longest} has {lines} lines, more than "
@@ -176,7 +213,7 @@ class _Renderer:
         self.source = post.plain_text(basename(compiled.program.source))
         self.main_file_names: set[str] = set()
 
-    def render(self, parts: list[tuple[Step, ...]]) -> dict[str, str]:
+    def render(self, parts: list[Part]) -> dict[str, str]:
         split = len(parts) > 1
         rule = self.rule
         unit_names = part_names(self.name, len(parts), rule.legal, rule.max_length) if split else []
@@ -193,36 +230,37 @@ class _Renderer:
         allocation = self.view.allocate(names)
         if not split:
             out = self._files(self.manifest.files, self._unit(parts[0], allocation, 0, 0, entry))
-            progress.advance(len(parts[0]))
+            progress.advance(_count(parts[0]))
             return out
         main = self._unit((), allocation, 0, len(parts), entry)
         main["parts"] = [
             {"name": n, "index": k + 1, "routine": r}
             for k, (n, r) in enumerate(zip(unit_names, routines, strict=True))
         ]
-        main["tools"], main["frames"] = _used(allocation, [s.index for s in self.compiled.steps])
+        main["tools"], main["frames"] = _used(allocation, _everything(self.compiled.steps))
         main_files = self._files(self.manifest.main_files, main)
         self.main_file_names = set(main_files)
         files: dict[str, str] = {}
         for k, (steps, unit_name) in enumerate(zip(parts, unit_names, strict=True)):
             unit = self._unit(steps, allocation, k + 1, len(parts), routines[k], unit_name)
             files.update(self._files(self.manifest.files, unit, clash=files.keys() | main_files))
-            progress.advance(len(steps))
+            progress.advance(_count(steps))
         return {**main_files, **files}
 
     def _unit(
         self,
-        steps: Sequence[Step],
+        steps: Part,
         allocation: Allocation,
         index: int,
         count: int,
         routine: str,
         unit_name: str | None = None,
     ) -> dict[str, Any]:
-        view = self.view.unit_steps(steps, allocation)
+        view: Sequence[Any] = self.view.unit_steps(steps, allocation)
         if self.post.WRITES_FLOW and self.compiled.program.has_flow:
+            # a program with control flow is rendered from steps only (Post.columns_enabled)
             view = weave(self.compiled.program, view)
-        tools, frames = _used(allocation, [s.index for s in view])
+        tools, frames = _used(allocation, view)
         name = unit_name or self.name
         return {
             "program": {"name": name, "source": self.source, "main": self.name},
@@ -286,15 +324,29 @@ def _template_line(exc: Exception, path: Path) -> int | str:
     return line if line is not None else "?"
 
 
-def _used(allocation: Allocation, indices: Sequence[int]) -> tuple[list[PostTool], list[PostFrame]]:
-    """The distinct tools and frames of the motions at ``indices``, in order of first use."""
+def _used(allocation: Allocation, steps: Sequence[Any]) -> tuple[list[PostTool], list[PostFrame]]:
+    """The distinct tools and frames of the motions of ``steps`` (steps, a file's view items,
+    toolpath blocks or their rows), in order of first use."""
     tools: dict[str, PostTool] = {}
     frames: dict[str, PostFrame] = {}
-    for i in indices:
-        if i in allocation.tools:
-            tools.setdefault(allocation.tools[i].name, allocation.tools[i])
-            frames.setdefault(allocation.frames[i].name, allocation.frames[i])
+    for s in steps:
+        if isinstance(s, RowColumns):
+            tools.setdefault(s.tool_item.name, s.tool_item)
+            frames.setdefault(s.frame_item.name, s.frame_item)
+        elif isinstance(s, PathBlock):
+            named = allocation.blocks.get(s.start)
+            if named is not None:
+                tools.setdefault(named.tool.name, named.tool)
+                frames.setdefault(named.frame.name, named.frame)
+        elif s.index in allocation.tools:
+            tools.setdefault(allocation.tools[s.index].name, allocation.tools[s.index])
+            frames.setdefault(allocation.frames[s.index].name, allocation.frames[s.index])
     return list(tools.values()), list(frames.values())
+
+
+def _everything(steps: Sequence[Step]) -> Sequence[Any]:
+    """The steps and toolpath blocks of a whole program."""
+    return items_of(steps)
 
 
 def _line_endings(text: str, ending: str) -> str:

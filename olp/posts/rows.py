@@ -8,18 +8,27 @@ and writes its lines in Python, formatting the numbers of the run column by colu
 (:meth:`olp.posts.base.Post.number_column`). The text is the same, byte for byte, as the
 template's for the same moves (``tests/posts/test_rows.py`` renders both ways); headers, data
 sections and every other instruction stay templates.
+
+A post whose row writer also takes columns (:attr:`olp.posts.base.Post.COLUMNS`) gets a dense
+toolpath's rows without any object per row: one :class:`~olp.posts.view.RowColumns` item per
+block (or per piece of a block in a split program) holding the block's arrays, its change flags
+computed over them; numbers are spelled and checked as whole columns (:func:`number_column`,
+exactly as :func:`olp.posts.numbers.format_number` spells each:
+``tests/posts/test_row_columns.py``).
 """
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
-from olp.posts.view import PostStep
+from olp.posts.numbers import NumberFormat, _spell
+from olp.posts.view import PostStep, RowColumns
 
 FloatArray = NDArray[np.float64]
 
@@ -55,12 +64,15 @@ class PostRows:
         return np.stack([s.pose for s in self.steps])  # type: ignore[misc]
 
 
-def group_rows(steps: Sequence[PostStep]) -> list[PostStep | PostRows]:
-    """``steps`` with every maximal run of consecutive linear moves as one :class:`PostRows`."""
-    out: list[PostStep | PostRows] = []
+def group_rows(
+    steps: Sequence[PostStep | RowColumns],
+) -> list[PostStep | PostRows | RowColumns]:
+    """``steps`` with every maximal run of consecutive linear moves as one :class:`PostRows`
+    (a toolpath's :class:`~olp.posts.view.RowColumns` stay as they are)."""
+    out: list[PostStep | PostRows | RowColumns] = []
     run: list[PostStep] = []
     for step in steps:
-        if step.kind == "linear" and step.motion:
+        if isinstance(step, PostStep) and step.kind == "linear" and step.motion:
             run.append(step)
             continue
         if run:
@@ -70,3 +82,103 @@ def group_rows(steps: Sequence[PostStep]) -> list[PostStep | PostRows]:
     if run:
         out.append(PostRows(tuple(run)))
     return out
+
+
+def spell_column(values: ArrayLike, decimals: int, compact: bool = False) -> NDArray[np.str_]:
+    """``format(v, f".{decimals}f")`` of every value (N,), as :mod:`olp.posts.numbers` spells
+    one (:func:`_spelled`)."""
+    return _spelled(np.asarray(values, dtype=np.float64).reshape(-1), decimals, compact)[0]
+
+
+def _spelled(v: FloatArray, decimals: int, compact: bool) -> tuple[NDArray[np.str_], FloatArray]:
+    """``format(v, f".{decimals}f")`` of values (N,) and the doubles the texts read back as:
+    as :func:`olp.posts.numbers.format_number` spells one (``-0.000`` is written ``0.000``;
+    ``compact`` drops trailing zeros and a bare point), formatted as integers with numpy.
+
+    A value times ``10**decimals`` is rounded to the nearest integer, which is what Python's
+    correctly rounded formatting gives unless the product lies within its own rounding error
+    of a half (or is too large for exact integers, or not finite): those few values are
+    spelled by Python itself.
+    """
+    scale = 10.0**decimals
+    with np.errstate(invalid="ignore", over="ignore"):
+        p = v * scale
+        r = np.rint(p)
+        frac = np.abs(p - np.trunc(p))
+        tol = np.maximum(1e-6, 8.0 * np.finfo(np.float64).eps * np.abs(p))
+        slow = ~(np.abs(p) < 2.0**50) | (np.abs(frac - 0.5) <= tol)
+    r[slow] = 0.0
+    whole = np.abs(r).astype(np.int64)
+    if decimals == 0:
+        body = _integers(whole)
+    else:
+        head, tail = np.divmod(whole, 10**decimals)
+        if decimals <= _TABLE_DECIMALS:
+            tails = _fractions(decimals)[tail]
+        else:
+            tails = np.strings.add(".", np.strings.zfill(tail.astype(np.str_), decimals))
+        body = np.strings.add(_integers(head), tails)
+    text = np.where(r < 0, np.strings.add("-", body), body)
+    if compact and decimals > 0:
+        text = np.strings.rstrip(np.strings.rstrip(text, "0"), ".")
+    if np.any(slow):
+        where = np.flatnonzero(slow)
+        exact = [_spell(x, decimals, compact) for x in v[where].tolist()]
+        width = max(text.dtype.itemsize // 4, max(len(t) for t in exact))
+        text = text.astype(f"<U{width}")
+        text[where] = exact
+    # What is printed, read back: integer / 10**decimals is one correctly rounded division,
+    # the same double as parsing the text.
+    printed = r / scale
+    if np.any(slow):
+        printed[slow] = [float(t) for t in exact]
+    return text, printed
+
+
+def number_column(values: ArrayLike, fmt: NumberFormat) -> tuple[NDArray[np.str_], bool]:
+    """Every value (N,) spelled in ``fmt`` (:func:`spell_column`) and whether all of them pass
+    :func:`olp.posts.numbers.format_number`'s checks (range after printing, what the
+    controller's storage holds), checked at once."""
+    v = np.asarray(values, dtype=np.float64).reshape(-1)
+    if v.size == 0:
+        return np.zeros(0, dtype="<U1"), True
+    if not np.all(np.isfinite(v) & (np.abs(v) <= 1e300)):
+        return np.zeros(0, dtype="<U1"), False
+    texts, printed = _spelled(v, fmt.decimals, fmt.compact)
+    low, high = fmt.bounds()
+    with np.errstate(over="ignore", invalid="ignore"):
+        if fmt.storage == "real32":
+            stored = printed.astype(np.float32).astype(np.float64)
+        elif fmt.storage == "int":
+            stored = np.round(printed)
+        else:
+            stored = printed
+        sane = np.abs(v) <= 2 * max(abs(low), abs(high)) if fmt.storage != "real64" else True
+        inside = (printed >= low) & (printed <= high) & ~(fmt.low_open & (printed <= low))
+        ok = bool(np.all(sane & inside & (np.abs(stored - v) <= fmt.tolerance)))
+    return texts, ok
+
+
+_TABLE_DECIMALS = 5
+"""Fractions of up to this many decimals are spelled by table look-up (10**5 entries)."""
+
+_SMALL = 1 << 17
+"""Integers below this are spelled by table look-up (faster than numpy's own conversion)."""
+
+
+@functools.cache
+def _small_integers() -> NDArray[np.str_]:
+    return np.array([str(k) for k in range(_SMALL)])
+
+
+@functools.cache
+def _fractions(decimals: int) -> NDArray[np.str_]:
+    """``.000`` ... ``.999`` for ``decimals`` 3: the point and the digits of every fraction."""
+    return np.array([f".{k:0{decimals}d}" for k in range(10**decimals)])
+
+
+def _integers(values: NDArray[np.int64]) -> NDArray[np.str_]:
+    """Non-negative integers (N,) in decimal."""
+    if values.size and int(values.max()) < _SMALL:
+        return _small_integers()[values]
+    return values.astype(np.str_)

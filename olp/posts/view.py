@@ -17,8 +17,18 @@ from typing import TYPE_CHECKING, Any, Protocol
 import numpy as np
 from numpy.typing import NDArray
 
+from olp.compiled import BlockRows, PathBlock, items_of
 from olp.geometry import inv
-from olp.ir import FLANGE, MOTION_TYPES, CartesianTarget, CircularMove, Frame, JointMove, Tool
+from olp.ir import (
+    FLANGE,
+    MOTION_TYPES,
+    CartesianTarget,
+    CircularMove,
+    Frame,
+    JointMove,
+    Tool,
+    Zone,
+)
 
 if TYPE_CHECKING:
     from olp.compiled import CompiledProgram, Step
@@ -44,6 +54,8 @@ class ViewHooks(Protocol):
     def manifest(self) -> PostManifest: ...
 
     def step_values(self, robot: Any, joints: FloatArray) -> list[Mapping[str, Any]]: ...
+
+    def step_columns(self, robot: Any, joints: FloatArray) -> Mapping[str, Any]: ...
 
     def comment_lines(self, text: str) -> tuple[str, ...]: ...
 
@@ -165,8 +177,10 @@ def build_steps(compiled: CompiledProgram, post: ViewHooks | None = None) -> lis
         hooks = Post(PostManifest("", "", Path("."), ()))
     else:
         hooks = post
+    compiled = compiled.flat()
     view = ProgramView(compiled, hooks)
-    return view.unit_steps(compiled.steps, view.allocate(Names(hooks.NAME_RULE, ())))
+    steps = view.unit_steps(compiled.steps, view.allocate(Names(hooks.NAME_RULE, ())))
+    return [s for s in steps if isinstance(s, PostStep)]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -181,6 +195,119 @@ class _Motion:
     base_pose: FloatArray
 
 
+@dataclass(frozen=True, slots=True, eq=False)
+class BlockMotions:
+    """A toolpath block's rows, computed once per render: ``number`` (the motion number of
+    row 0), ``frame_pose`` (the frame relative to the reference, (4, 4) m) and ``columns``
+    (the post's per-row values, each an array (N,))."""
+
+    block: PathBlock
+    number: int
+    frame_pose: FloatArray
+    columns: Mapping[str, Any]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class BlockNames:
+    """A toolpath block's point names (one per row) and its named tool and frame."""
+
+    names: Sequence[str]
+    tool: PostTool
+    frame: PostFrame
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class RowColumns:
+    """Rows ``piece.lo`` .. ``piece.hi`` of a toolpath block as one item of a file's steps
+    (``kind`` ``"rows"``): what a post's column writer formats, as arrays, with no object per
+    row. ``motion`` is 0 so that a template's motion branch skips it; ``index``, ``source`` and
+    ``instruction`` are the first row's. ``new_tool``/``new_frame``: row 0 changes the tool /
+    frame (the rows share one of each); ``new_linear_speed``/``new_zone`` (n,): the row's speed
+    / zone differs from the motion before it in this file. :meth:`at` is row ``k`` as a
+    :class:`PostStep` (for the few rows that need one: a changed frame, an error's line)."""
+
+    piece: BlockRows
+    motions: BlockMotions
+    names: Sequence[str]
+    tool_item: PostTool
+    frame_item: PostFrame
+    new_tool: bool
+    new_frame: bool
+    new_linear_speed: NDArray[np.bool_]
+    new_zone: NDArray[np.bool_]
+    kind: str = "rows"
+    motion: int = 0
+
+    def __len__(self) -> int:
+        return len(self.piece)
+
+    @property
+    def node(self) -> Any:
+        return self.piece.block.node
+
+    @property
+    def index(self) -> int:
+        return self.piece.index
+
+    @property
+    def source(self) -> str:
+        return str(self.node.row_span(self.piece.lo).location)
+
+    @property
+    def instruction(self) -> Any:
+        return self.node.move(self.piece.lo)
+
+    @property
+    def poses(self) -> FloatArray:
+        """The targets (n, 4, 4) m in the frame."""
+        return self.node.poses[self.piece.lo : self.piece.hi]
+
+    @property
+    def speeds(self) -> FloatArray:
+        """Path speeds (n,) m/s."""
+        return self.node.speeds[self.piece.lo : self.piece.hi]
+
+    @property
+    def zones(self) -> FloatArray:
+        """Zone radii (n,) m (0: a fine stop)."""
+        return self.node.zones[self.piece.lo : self.piece.hi]
+
+    def column(self, key: str) -> NDArray[Any]:
+        """The post's per-row value ``key`` (``vendor[key]`` of a step), (n,)."""
+        values: NDArray[Any] = self.motions.columns[key]
+        return values[self.piece.lo : self.piece.hi]
+
+    def at(self, k: int) -> PostStep:
+        """Row ``k`` of these rows as the :class:`PostStep` a template would see."""
+        block, row = self.piece.block, self.piece.lo + k
+        node, motions = block.node, self.motions
+        assert block.joints is not None
+        pose = node.poses[row]
+        return PostStep(
+            block.start + row,
+            "linear",
+            node.row_span(row).location,
+            node.move(row),
+            joints=block.joints[row],
+            pose=pose,
+            tool=block.tool,
+            frame=block.frame,
+            cartesian=True,
+            motion=motions.number + row,
+            name=self.names[k],
+            tool_name=self.tool_item.name,
+            frame_name=self.frame_item.name,
+            frame_pose=motions.frame_pose,
+            base_pose=motions.frame_pose @ pose,
+            duration=0.0 if block.durations is None else float(block.durations[row]),
+            vendor={key: v[row].item() for key, v in motions.columns.items()},
+            new_tool=self.new_tool and k == 0,
+            new_frame=self.new_frame and k == 0,
+            new_zone=bool(self.new_zone[k]),
+            new_linear_speed=bool(self.new_linear_speed[k]),
+        )
+
+
 @dataclass(frozen=True, slots=True)
 class Allocation:
     """Names given to one program's points, tools and frames."""
@@ -188,6 +315,8 @@ class Allocation:
     points: Mapping[int, tuple[str, str]]
     tools: Mapping[int, PostTool]
     frames: Mapping[int, PostFrame]
+    blocks: Mapping[int, BlockNames] = field(default_factory=dict)
+    """Per toolpath block (by its first instruction index): its rows' names, tool and frame."""
 
 
 class ProgramView:
@@ -201,37 +330,62 @@ class ProgramView:
         self.reference = (
             robot.base @ robot.controller_base if manifest.frames_in == "robot_base" else np.eye(4)
         )
+        self._ref_inv = inv(self.reference)
+        self._frame_poses: dict[int, tuple[Frame, FloatArray]] = {}
+        self.blocks: dict[int, BlockMotions] = {}
+        """Per toolpath block (by its first instruction index), its rows as columns."""
         self.motions = self._motions()
 
     def _motions(self) -> dict[int, _Motion]:
-        written = [s for s in self.compiled.steps if _written_motion(s)]
+        from olp.compiled import PathBlock, items_of
+
+        number = 0
+        written: list[tuple[Step, int]] = []
+        for item in items_of(self.compiled.steps):
+            if isinstance(item, PathBlock):
+                if item.joints is not None:
+                    self.blocks[item.start] = self._block_motions(item, number + 1)
+                    number += len(item)
+            elif _written_motion(item):
+                number += 1
+                written.append((item, number))
         if not written:
             return {}
         robot = self.compiled.station.robot
-        joints = np.stack([np.asarray(s.joints, dtype=np.float64) for s in written])
+        joints = np.stack([np.asarray(s.joints, dtype=np.float64) for s, _ in written])
         flanges = robot.flange_poses(joints)
         values = self._vendor_values(joints)
-        ref_inv = inv(self.reference)
         # Frames are few (a toolpath's rows share one object): each one's pose once.
-        frame_poses: dict[int, FloatArray] = {}
-        for step in written:
-            assert step.frame is not None and step.frame.pose is not None
-            if id(step.frame) not in frame_poses:
-                frame_poses[id(step.frame)] = ref_inv @ step.frame.pose
-        framed = [frame_poses[id(s.frame)] for s in written]
-        poses = np.stack([_pose_in_frame(s, f) for s, f in zip(written, flanges, strict=True)])
+        framed = [self._frame_pose(s.frame) for s, _ in written]
+        poses = np.stack([_pose_in_frame(s, f) for (s, _), f in zip(written, flanges, strict=True)])
         bases = np.stack(framed) @ poses
         out = {}
-        for n, (step, vendor) in enumerate(zip(written, values, strict=True)):
+        for n, ((step, k), vendor) in enumerate(zip(written, values, strict=True)):
             out[step.index] = _Motion(
                 pose=poses[n],
                 frame_pose=framed[n],
                 via=_via(step),
                 vendor=vendor,
-                number=n + 1,
+                number=k,
                 base_pose=bases[n],
             )
         return out
+
+    def _frame_pose(self, frame: Frame | None) -> FloatArray:
+        """``frame`` relative to the reference (once per frame object)."""
+        assert frame is not None and frame.pose is not None
+        known = self._frame_poses.get(id(frame))
+        if known is None or known[0] is not frame:
+            known = (frame, self._ref_inv @ frame.pose)
+            self._frame_poses[id(frame)] = known
+        return known[1]
+
+    def _block_motions(self, block: PathBlock, number: int) -> BlockMotions:
+        """A toolpath's rows as columns: targets in the frame (the rows are Cartesian), the
+        post's per-row values as arrays (:meth:`ViewHooks.step_columns`)."""
+        assert block.joints is not None
+        columns = self.post.step_columns(self.compiled.station.robot, block.joints)
+        return BlockMotions(block, number, self._frame_pose(block.frame), columns)
 
     def _vendor_values(self, joints: FloatArray) -> list[Mapping[str, Any]]:
         return self.post.step_values(self.compiled.station.robot, joints)
@@ -244,28 +398,63 @@ class ProgramView:
         points: dict[int, tuple[str, str]] = {}
         tools: dict[int, PostTool] = {}
         frames: dict[int, PostFrame] = {}
-        tool_keys: dict[tuple[str, bytes], PostTool] = {}
-        frame_keys: dict[tuple[str, bytes], PostFrame] = {}
+        self._tool_keys: dict[tuple[str, bytes], PostTool] = {}
+        self._frame_keys: dict[tuple[str, bytes], PostFrame] = {}
         # The same tool or frame object again (a toolpath's rows): the same named one.
         by_object: dict[int, tuple[Any, PostTool | PostFrame]] = {}
-        for step in self.compiled.steps:
+        blocks: dict[int, BlockNames] = {}
+        for item in items_of(self.compiled.steps):
+            if isinstance(item, PathBlock):
+                if item.start in self.blocks:
+                    blocks[item.start] = self._block_names(item, names, point_pattern, by_object)
+                continue
+            step = item
             motion = self.motions.get(step.index)
             if motion is None:
                 continue
             via = names.take(via_pattern.format(n=motion.number)) if motion.via is not None else ""
             points[step.index] = (names.take(point_pattern.format(n=motion.number)), via)
-            assert step.tool is not None and step.frame is not None
-            known = by_object.get(id(step.tool))
-            if known is None or known[0] is not step.tool:
-                known = (step.tool, self._tool(step.tool, tool_keys, names))
-                by_object[id(step.tool)] = known
-            tools[step.index] = known[1]  # type: ignore[assignment]
-            seen = by_object.get(id(step.frame))
-            if seen is None or seen[0] is not step.frame:
-                seen = (step.frame, self._frame(step.frame, motion.frame_pose, frame_keys, names))
-                by_object[id(step.frame)] = seen
-            frames[step.index] = seen[1]  # type: ignore[assignment]
-        return Allocation(points, tools, frames)
+            tools[step.index], frames[step.index] = self._tool_frame(
+                step.tool, step.frame, motion.frame_pose, names, by_object
+            )
+        return Allocation(points, tools, frames, blocks)
+
+    def _tool_frame(
+        self,
+        tool: Tool | None,
+        frame: Frame | None,
+        frame_pose: FloatArray,
+        names: Names,
+        by_object: dict[int, tuple[Any, Any]],
+    ) -> tuple[PostTool, PostFrame]:
+        """The named tool and frame of a motion (the same object again: the same named one)."""
+        assert tool is not None and frame is not None
+        known = by_object.get(id(tool))
+        if known is None or known[0] is not tool:
+            known = (tool, self._tool(tool, self._tool_keys, names))
+            by_object[id(tool)] = known
+        seen = by_object.get(id(frame))
+        if seen is None or seen[0] is not frame:
+            seen = (frame, self._frame(frame, frame_pose, self._frame_keys, names))
+            by_object[id(frame)] = seen
+        return known[1], seen[1]
+
+    def _block_names(
+        self,
+        block: PathBlock,
+        names: Names,
+        pattern: str,
+        by_object: dict[int, tuple[Any, Any]],
+    ) -> BlockNames:
+        """A toolpath's point names, taken in the order the rows' steps would take them: row
+        0's, then the tool's and the frame's (when first met), then the others'."""
+        motions = self.blocks[block.start]
+        first = names.take(pattern.format(n=motions.number))
+        tool, frame = self._tool_frame(
+            block.tool, block.frame, motions.frame_pose, names, by_object
+        )
+        wanted = [pattern.format(n=motions.number + k) for k in range(1, len(block))]
+        return BlockNames([first, *names.take_many(wanted)], tool, frame)
 
     def _tool(self, tool: Tool, seen: dict[tuple[str, bytes], PostTool], names: Names) -> PostTool:
         assert tool.pose is not None
@@ -300,11 +489,18 @@ class ProgramView:
             )
         return seen[key]
 
-    def unit_steps(self, steps: Sequence[Step], names: Allocation) -> list[PostStep]:
-        """The template view of ``steps`` as one file: change flags start afresh."""
-        out: list[PostStep] = []
+    def unit_steps(
+        self, steps: Sequence[Step | BlockRows], names: Allocation
+    ) -> list[PostStep | RowColumns]:
+        """The template view of ``steps`` as one file: change flags start afresh. A toolpath's
+        rows (:class:`~olp.compiled.BlockRows`) are one :class:`RowColumns` item."""
+        out: list[PostStep | RowColumns] = []
         last: dict[str, Any] = {}
         for step in steps:
+            if isinstance(step, BlockRows):
+                if step.block.start in self.blocks:
+                    out.append(self._rows(step, names, last))
+                continue
             ins = step.instruction
             if not isinstance(ins, MOTION_TYPES):
                 lines = self.post.comment_lines(ins.text) if ins.kind == "comment" else ()
@@ -312,6 +508,37 @@ class ProgramView:
             elif step.index in self.motions:
                 out.append(self._motion_step(step, names, last))
         return out
+
+    def _rows(self, piece: BlockRows, names: Allocation, last: dict[str, Any]) -> RowColumns:
+        """A toolpath's rows as columns, their change flags computed over the arrays (the rows
+        share one tool and frame; angular speed and accelerations are the block's)."""
+        block = piece.block
+        node = block.node
+        named = names.blocks[block.start]
+        new_tool = _changed_object(last, "tool", block.tool)
+        new_frame = _changed_object(last, "frame", block.frame)
+        zones = node.zones[piece.lo : piece.hi]
+        speeds = node.speeds[piece.lo : piece.hi]
+        new_zone = np.empty(len(piece), dtype=bool)
+        new_zone[0] = _changed_value(last, "zone", Zone(float(zones[0])))
+        new_zone[1:] = zones[1:] != zones[:-1]
+        last["zone"] = Zone(float(zones[-1]))
+        rest = (node.angular, node.acceleration, node.angular_acceleration)
+        new_speed = np.empty(len(piece), dtype=bool)
+        new_speed[0] = _changed_value(last, "linear_speed", (float(speeds[0]), *rest))
+        new_speed[1:] = speeds[1:] != speeds[:-1]
+        last["linear_speed"] = (float(speeds[-1]), *rest)
+        return RowColumns(
+            piece,
+            self.blocks[block.start],
+            named.names[piece.lo : piece.hi],
+            named.tool,
+            named.frame,
+            new_tool,
+            new_frame,
+            new_speed,
+            new_zone,
+        )
 
     def _motion_step(self, step: Step, names: Allocation, last: dict[str, Any]) -> PostStep:
         ins: Any = step.instruction
@@ -417,6 +644,33 @@ class Names:
         self.taken.add(name.casefold())
         return name
 
+    def take_many(self, wanted: Sequence[str]) -> list[str]:
+        """:meth:`take` of each name in order; at once when all are legal as they are, distinct
+        and free (a toolpath's generated point names)."""
+        folded = {w.casefold() for w in wanted}
+        if (
+            len(folded) == len(wanted)
+            and folded.isdisjoint(self.taken)
+            and self._all_legal_as_is(wanted)
+        ):
+            self.taken |= folded
+            return list(wanted)
+        return [self.take(w) for w in wanted]
+
+    def _all_legal_as_is(self, names: Sequence[str]) -> bool:
+        """:meth:`_legal_as_is` of every name, checked on the names joined by line breaks."""
+        if not names:
+            return True
+        rule = self.rule
+        joined = "\n".join(names)
+        compared = names if rule.case_sensitive else [n.upper() for n in names]
+        return (
+            _PLAIN_NAMES.fullmatch(joined) is not None
+            and (not rule.upper or joined == joined.upper())
+            and (rule.max_length is None or max(map(len, names)) <= rule.max_length)
+            and rule.reserved.isdisjoint(compared)
+        )
+
     def _legal_as_is(self, name: str) -> bool:
         """Whether ``rule.legal(name)`` is ``name`` itself, without building it (a point name
         per row of a toolpath): ASCII letters, digits and ``_``, a letter first, upper case
@@ -431,6 +685,7 @@ class Names:
 
 
 _PLAIN_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
+_PLAIN_NAMES = re.compile(r"[A-Za-z][A-Za-z0-9_]*(?:\n[A-Za-z][A-Za-z0-9_]*)*")
 
 
 class Modal:
