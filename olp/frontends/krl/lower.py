@@ -47,12 +47,12 @@ from olp.frontends.krl.data import OTHER_REASONS, KrlData
 from olp.frontends.krl.events import Events
 from olp.frontends.krl.flow import assigned_names, is_straight, jump_targets, statements, to_expr
 from olp.frontends.krl.motion import Motions
+from olp.frontends.krl.rows import build_instructions
 from olp.frontends.krl.state import (
     DEFAULT_VEL_CP,
     Context,
     KrlResult,
     State,
-    build_instructions,
     is_here,
 )
 from olp.frontends.krl.values import (
@@ -522,7 +522,7 @@ class _Lowering(Motions, Events):
     def _branch(self, body: Sequence[Stmt], loop: bool = False) -> tuple[_Lowering, Body]:
         child = self._child(loop)
         child.lower_body(body)
-        return child, build_instructions(child.out)
+        return child, build_instructions(child.out, dense=False)
 
     def _loop_body(self, body: Sequence[Stmt], keyword: str, span: ir.SourceSpan) -> Body:
         """A loop's body, lowered once from the state every pass may start with: variables it

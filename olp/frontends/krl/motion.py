@@ -1,7 +1,7 @@
 """KRL lowering of motions: PTP/LIN/CIRC, their spline and _REL forms, and the fast path.
 
 Targets are inline aggregates or named points; Cartesian ones stay KRL values (mm, deg) until
-:func:`olp.frontends.krl.state.build_instructions`. See :mod:`olp.frontends.krl` for the rules.
+:func:`olp.frontends.krl.rows.build_instructions`. See :mod:`olp.frontends.krl` for the rules.
 """
 
 from __future__ import annotations

@@ -8,7 +8,8 @@ value helpers that raise located errors, and the assignments of system variables
 calls and loops) build on it, in that order.
 
 Cartesian targets are collected as KRL values (mm, deg) and converted to poses in one vectorised
-call at the end (:func:`build_instructions`), as milling programs have tens of thousands of them.
+call at the end (:func:`olp.frontends.krl.rows.build_instructions`), as milling programs have
+tens of thousands of them.
 """
 
 from __future__ import annotations
@@ -16,11 +17,9 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
-
-import numpy as np
 
 from olp import ir
 from olp.errors import ParseError
@@ -145,7 +144,8 @@ Target = ir.JointTarget | Cartesian
 
 @dataclass(frozen=True, slots=True)
 class Pending:
-    """A motion whose Cartesian target(s) get their poses in :func:`build_instructions`."""
+    """A motion whose Cartesian target(s) get their poses in
+    :func:`olp.frontends.krl.rows.build_instructions`."""
 
     make: Callable[..., ir.Instruction]
     target: Target
@@ -716,31 +716,3 @@ class Core:
 def element_span(element: Value, default: ir.SourceSpan) -> ir.SourceSpan:
     span = getattr(element, "span", None)
     return span if isinstance(span, ir.SourceSpan) else default
-
-
-def build_instructions(out: Sequence[ir.Node | Pending]) -> tuple[ir.Node, ...]:
-    """The instructions, with all Cartesian poses computed in one vectorised call."""
-    values = []
-    for item in out:
-        if isinstance(item, Pending):
-            assert isinstance(item.target, Cartesian)
-            values.append(item.target.values)
-            if item.via is not None:
-                values.append(item.via.values)
-    poses = iter(frame_to_pose(np.array(values, dtype=np.float64).reshape(-1, 6)))
-    built: list[ir.Node] = []
-    for item in out:
-        if not isinstance(item, Pending):
-            built.append(item)
-            continue
-        target = item.target
-        assert isinstance(target, Cartesian)
-        fields = dict(item.fields)
-        fields["target"] = ir.CartesianTarget(
-            pose=next(poses), config=target.config, name=target.name
-        )
-        if item.via is not None:
-            via = item.via
-            fields["via"] = ir.CartesianTarget(pose=next(poses), config=via.config, name=via.name)
-        built.append(item.make(**fields))
-    return tuple(built)
