@@ -15,6 +15,7 @@ import pytest
 import olp
 from olp import ir
 from olp.api import BuildResult
+from olp.errors import ParseError
 from olp.frontends.krl import KrlResult, parse_krl, rows
 from olp.station.model import Station
 
@@ -153,3 +154,40 @@ def test_a_row_diagnostic_names_its_line(station: Station, monkeypatch: pytest.M
     errors = [d for d in built.diagnostics if d.severity == "error"]
     assert errors and errors[0].span == ir.SourceSpan("helix.src", 77, 1, 77, len(body[70]) + 1)
     assert errors[0].index == 71
+
+
+CAM_ROWS = [lin(i, 80) for i in range(80)]
+
+
+@pytest.mark.parametrize(
+    "before",
+    [
+        [],
+        ["$ORI_TYPE = #CONSTANT"],
+        ["SLIN {X 150,Y 0,Z 30,A -180,B 0,C -180} WITH $VEL.CP = 0.1"],
+        ["$APO = {CDIS 0.0}", "BAS(#INITMOV, 0)"],
+        ["RETURN"],
+        ["GOTO skip"],
+        ["IF $IN[1] THEN", "$VEL.CP = 0.1", "ENDIF"],
+    ],
+)
+def test_rows_read_as_the_grammar_reads_them(
+    before: list[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    body = [*before, *CAM_ROWS, *(["skip:"] if "GOTO skip" in before else [])]
+    for header in (HEADER, HEADER[:3] + HEADER[5:]):  # with and without $VEL.CP, $APO.CDIS
+        text = "\n".join([*header, *body, "END"])
+        assert outcome(text, True) == outcome(text, False)
+
+
+@pytest.mark.parametrize("wrap", [("FOR I = 1 TO 3", "ENDFOR"), ("IF $IN[1] THEN", "ENDIF")])
+def test_rows_in_loops_and_blocks(wrap: tuple[str, str]) -> None:
+    text = "\n".join([*HEADER, "DECL INT I", wrap[0], *CAM_ROWS, wrap[1], "END"])
+    assert outcome(text, True) == outcome(text, False)
+
+
+def outcome(text: str, fast: bool) -> KrlResult | tuple[str, object]:
+    try:
+        return parse_krl(text, "t.src", fast_path=fast)
+    except ParseError as error:
+        return error.message, error.span

@@ -13,14 +13,21 @@ result is the same as the grammar's, spans included (pinned by tests that compar
 * members named only ``X Y Z A B C S T A1..A6 E1..E6`` (none is a KRL keyword, so the lexer
   cannot read them differently), an optional type ``E6POS POS FRAME AXIS E6AXIS``;
 * values that are plain signed numbers, each followed by ``,`` or ``}``.
+
+CAM posts write one shape of LIN line, always the same way (``LIN {X 1.000,Y -2.500,Z 6.350,
+A -180.000,B 0.000,C -180.000} C_DIS``). :class:`RowReader` takes consecutive lines of exactly
+that shape (a strict subset of what :func:`scan_line` accepts) as :class:`LinRows`: one regular
+expression per line, and the numbers of the whole run converted by numpy in one call.
 """
 
 from __future__ import annotations
 
 import re
 
+import numpy as np
+
 from olp import ir
-from olp.frontends.krl.ast import Aggregate, FastMotion, Member, MotionStmt, Num
+from olp.frontends.krl.ast import Aggregate, FastMotion, LinRows, Member, MotionStmt, Num
 
 # A character that continues a KRL name: where a keyword or member name must not be followed by one.
 _NAME_CHAR = r"[a-z0-9_$]"
@@ -42,6 +49,14 @@ _LINE = re.compile(
     rf"{_WS}(?:;.*)?\r?",
     re.IGNORECASE,
 )
+# The exact CAM shape, in column 1: keyword, member names and C_DIS upper case, no blanks but
+# the one after each name. Groups: 1-6 the numbers X..C, 7 the approximation (or None).
+_ROW_NUMBER = _NUMBER.replace("e[+-]", "[eE][+-]")
+_ROW = re.compile(
+    rf"LIN \{{X ({_ROW_NUMBER}),Y ({_ROW_NUMBER}),Z ({_ROW_NUMBER}),"
+    rf"A ({_ROW_NUMBER}),B ({_ROW_NUMBER}),C ({_ROW_NUMBER})\}}( C_DIS)?\r?"
+)
+row_match = _ROW.fullmatch
 _MEMBERS = re.compile(_MEMBER, re.IGNORECASE)
 _TYPE_PREFIX = re.compile(_TYPE, re.IGNORECASE)
 _APPROX_WORD = re.compile(_APPROX, re.IGNORECASE)
@@ -95,3 +110,48 @@ def materialise(fast: FastMotion) -> MotionStmt:
     type_name = None if prefix is None else prefix.group(1)
     aggregate = Aggregate(type_name, tuple(members), span(agg_start, match.end(2)))
     return MotionStmt(fast.keyword, (aggregate,), None, fast.approx, fast.span)
+
+
+class RowReader:
+    """Collects consecutive lines of the CAM shape (``row_match``) into one :class:`LinRows`."""
+
+    def __init__(self, filename: str) -> None:
+        self.filename = filename
+        self._numbers: list[str] = []
+        self._approx: list[bool] = []
+        self._lines: list[int] = []
+        self._ends: list[int] = []
+        self._texts: list[str] = []
+
+    def add(self, match: re.Match[str], number: int) -> None:
+        """Line ``number`` (1-based), matched by ``row_match``."""
+        self._numbers.extend(match.group(1, 2, 3, 4, 5, 6))
+        end = match.end(7)
+        self._approx.append(end >= 0)
+        self._ends.append(end + 1 if end >= 0 else match.end(6) + 2)
+        self._lines.append(number)
+        self._texts.append(match.string)
+
+    def flush(self) -> list[LinRows]:
+        """The rows collected since the last flush (none or one :class:`LinRows`)."""
+        if not self._lines:
+            return []
+        # numpy reads each token as float() does (correctly rounded, "-0.000" is -0.0).
+        values = np.array(self._numbers, dtype=np.float64).reshape(-1, 6)
+        lines = np.array(self._lines, dtype=np.int64)
+        ends = np.array(self._ends, dtype=np.int64)
+        span = ir.SourceSpan(self.filename, self._lines[0], 1, self._lines[0], self._ends[0])
+        rows = LinRows(values, np.array(self._approx), lines, ends, tuple(self._texts), span)
+        self.__init__(self.filename)  # type: ignore[misc]
+        return [rows]
+
+
+def row_motions(rows: LinRows) -> tuple[FastMotion, ...]:
+    """The rows as the :class:`FastMotion` statements :func:`scan_line` reads from them."""
+    filename = rows.span.file
+    motions = tuple(
+        scan_line(text, int(line), filename)
+        for text, line in zip(rows.texts, rows.lines, strict=True)
+    )
+    assert all(m is not None for m in motions), "a row of the CAM shape is a fast line"
+    return motions  # type: ignore[return-value]

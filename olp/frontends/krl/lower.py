@@ -30,6 +30,7 @@ from olp.frontends.krl.ast import (
     Index,
     InterruptCtl,
     InterruptDecl,
+    LinRows,
     Module,
     MotionStmt,
     Other,
@@ -145,6 +146,7 @@ class _Lowering(Motions, Events):
         }
         self._statements: dict[type, Callable[[Any], None]] = {
             FastMotion: self._fast_motion,
+            LinRows: self._lin_rows,
             MotionStmt: self._motion_or_here,
             Assign: self._assign,
             CallStmt: self._call,
@@ -180,6 +182,9 @@ class _Lowering(Motions, Events):
             self.lower_statement(stmt)
 
     def lower_statement(self, stmt: Stmt) -> None:
+        if isinstance(stmt, LinRows):  # checks and spends per row itself
+            self._lin_rows(stmt)
+            return
         if self.returned is not None:
             routine, line = self.returned
             self._ignore(stmt, f"unreachable: {routine} returns at line {line}")

@@ -13,13 +13,12 @@ path and orientation accelerations). Per-row path speeds and zones are arrays.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from olp import ir
-from olp.frontends.krl.state import Cartesian, Pending
+from olp.frontends.krl.state import Cartesian, Pending, PendingRows
 from olp.vendors.kuka import frame_to_pose
 
 DENSE_MIN_ROWS = 64
@@ -28,27 +27,6 @@ the examples and golden jobs) have short runs between their I/O, waits and PTPs 
 one-object-per-motion IR they are written as; CAM toolpaths run to thousands of rows, where a
 node of arrays saves the per-move objects and checks. At 64 rows a node's fixed cost (a few
 array allocations and one vectorised validation, ~50 us) is below 1 us per row."""
-
-
-@dataclass(frozen=True, slots=True)
-class PendingRows:
-    """A run of plain LIN motions read as arrays (see :meth:`Motions._lower_rows`).
-
-    ``values`` (N, 6): X, Y, Z (mm), A, B, C (deg) in ``fields["frame"]``; ``speeds`` (N,) m/s;
-    ``zones`` (N,) m; ``lines`` (N,) 1-based source lines; ``ends`` (N,) each row's end column
-    (exclusive, 1-based; every row starts in column 1). ``fields`` holds the speed (its linear
-    part is the first row's), tool, frame and file all rows share.
-    """
-
-    values: np.ndarray
-    speeds: np.ndarray
-    zones: np.ndarray
-    lines: np.ndarray
-    ends: np.ndarray
-    fields: dict[str, Any]
-
-    def __len__(self) -> int:
-        return int(self.values.shape[0])
 
 
 Item = ir.Node | Pending | PendingRows
@@ -74,8 +52,10 @@ def build_instructions(out: Sequence[Item], dense: bool = True) -> tuple[ir.Node
         elif isinstance(item, Pending):
             built.append(_single(item, poses, start))
             start += 1 if item.via is None else 2
+        elif isinstance(item, PendingRows):
+            built.extend(_row_moves(item, poses[start : start + len(item)]))
+            start += len(item)
         else:
-            assert not isinstance(item, PendingRows), "rows are built only in dense mode"
             built.append(item)
     if group:
         _flush(group, poses, start, built)

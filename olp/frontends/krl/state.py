@@ -21,6 +21,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
+import numpy as np
+
 from olp import ir
 from olp.errors import ParseError
 from olp.frontends.krl.ast import (
@@ -151,6 +153,28 @@ class Pending:
     target: Target
     via: Cartesian | None
     fields: dict[str, Any]
+
+
+@dataclass(frozen=True, slots=True)
+class PendingRows:
+    """A run of plain LIN motions read as arrays (see
+    :meth:`olp.frontends.krl.motion.Motions._lin_rows`).
+
+    ``values`` (N, 6): X, Y, Z (mm), A, B, C (deg) in ``fields["frame"]``; ``speeds`` (N,) m/s;
+    ``zones`` (N,) m; ``lines`` (N,) 1-based source lines; ``ends`` (N,) each row's end column
+    (exclusive, 1-based; every row starts in column 1). ``fields`` holds the speed (its linear
+    part is the first row's), tool, frame and file all rows share.
+    """
+
+    values: np.ndarray
+    speeds: np.ndarray
+    zones: np.ndarray
+    lines: np.ndarray
+    ends: np.ndarray
+    fields: dict[str, Any]
+
+    def __len__(self) -> int:
+        return int(self.values.shape[0])
 
 
 _F = TypeVar("_F", ir.Frame, ir.Tool)
@@ -315,7 +339,7 @@ class Core:
         self.variables = variables
         self.evaluator = Evaluator(variables, ctx.sources.snippet)
         self.data = DataOps(variables, self.evaluator, ctx.sources)
-        self.out: list[ir.Node | Pending] = []
+        self.out: list[ir.Node | Pending | PendingRows] = []
         self.ignored: list[IgnoredLine] = []
         self.notes: list[Note] = []
         self.status_turn: list[StatusTurn] = []
