@@ -191,3 +191,17 @@ def outcome(text: str, fast: bool) -> KrlResult | tuple[str, object]:
         return parse_krl(text, "t.src", fast_path=fast)
     except ParseError as error:
         return error.message, error.span
+
+
+def test_rows_with_windows_line_ends_and_every_number_form() -> None:
+    numbers = ["-0.000", "+2.5", "1e3", "1.5E-3", ".5", "12.", "7", "-180"]
+    odd = [
+        f"LIN {{X {a},Y {b},Z 30.000,A -180.000,B 0.000,C {c}}}{z}"
+        for a, b, c, z in zip(
+            numbers, reversed(numbers), numbers[3:] + numbers[:3], ["", " C_DIS"] * 4, strict=True
+        )
+    ]
+    text = "\r\n".join([*HEADER, *CAM_ROWS[:40], *odd, *CAM_ROWS[40:], "END", ""])
+    fast = outcome(text, True)
+    assert isinstance(fast, KrlResult) and ("LinearPath", 88) in kinds(fast)
+    assert fast == outcome(text, False)
