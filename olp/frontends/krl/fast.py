@@ -113,36 +113,40 @@ def materialise(fast: FastMotion) -> MotionStmt:
 
 
 class RowReader:
-    """Collects consecutive lines of the CAM shape (``row_match``) into one :class:`LinRows`."""
+    """Collects consecutive lines of the CAM shape (``row_match``) into one :class:`LinRows`.
+
+    Per line only the match and its number are kept (:meth:`add` is two appends: it runs for
+    every line of a toolpath); :meth:`flush` takes the run's numbers apart in bulk.
+    """
 
     def __init__(self, filename: str) -> None:
         self.filename = filename
-        self._numbers: list[str] = []
-        self._approx: list[bool] = []
-        self._lines: list[int] = []
-        self._ends: list[int] = []
-        self._texts: list[str] = []
+        self.matches: list[re.Match[str]] = []
+        self.lines: list[int] = []
 
     def add(self, match: re.Match[str], number: int) -> None:
         """Line ``number`` (1-based), matched by ``row_match``."""
-        self._numbers.extend(match.group(1, 2, 3, 4, 5, 6))
-        end = match.end(7)
-        self._approx.append(end >= 0)
-        self._ends.append(end + 1 if end >= 0 else match.end(6) + 2)
-        self._lines.append(number)
-        self._texts.append(match.string)
+        self.matches.append(match)
+        self.lines.append(number)
 
     def flush(self) -> list[LinRows]:
         """The rows collected since the last flush (none or one :class:`LinRows`)."""
-        if not self._lines:
+        matches = self.matches
+        if not matches:
             return []
+        numbers = [number for m in matches for number in m.group(1, 2, 3, 4, 5, 6)]
         # numpy reads each token as float() does (correctly rounded, "-0.000" is -0.0).
-        values = np.array(self._numbers, dtype=np.float64).reshape(-1, 6)
-        lines = np.array(self._lines, dtype=np.int64)
-        ends = np.array(self._ends, dtype=np.int64)
-        span = ir.SourceSpan(self.filename, self._lines[0], 1, self._lines[0], self._ends[0])
-        rows = LinRows(values, np.array(self._approx), lines, ends, tuple(self._texts), span)
-        self.__init__(self.filename)  # type: ignore[misc]
+        values = np.array(numbers, dtype=np.float64).reshape(-1, 6)
+        approx_ends = np.array([m.end(7) for m in matches], dtype=np.int64)
+        approx = approx_ends >= 0
+        # End column (1-based, exclusive): after C_DIS, else after the closing brace.
+        ends = np.where(approx, approx_ends + 1, [m.end(6) + 2 for m in matches])
+        lines = np.array(self.lines, dtype=np.int64)
+        first, end = self.lines[0], int(ends[0])
+        span = ir.SourceSpan(self.filename, first, 1, first, end)
+        rows = LinRows(values, approx, lines, ends, tuple(m.string for m in matches), span)
+        self.matches.clear()  # in place: the reader's caller may hold their append methods
+        self.lines.clear()
         return [rows]
 
 

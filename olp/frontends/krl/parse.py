@@ -529,10 +529,12 @@ def _substitute_fast_runs(source: Source) -> tuple[str, dict[int, tuple[Stmt, ..
     run: list[Stmt] = []
     first = 0  # line of the current run's placeholder (0: no run)
     rows = RowReader(source.filename)
+    matched, matched_lines = rows.matches.append, rows.lines.append
     for index, line in enumerate(lines):
         match = row_match(line)
         if match is not None:
-            rows.add(match, index + 1)
+            matched(match)  # RowReader.add, without a call per line
+            matched_lines(index + 1)
         else:
             fast = scan_line(line, index + 1, source.filename) if line else None
             run.extend(rows.flush())
