@@ -15,13 +15,22 @@ lines, as CAM posts write them. It is written to a temporary file and timed as:
 
 Everything runs on one core. Times are the best of R runs (the grammar is built before timing).
 The last lines give each time as a ratio to ``load_krl``'s.
+
+With ``--reference DIR`` (a checkout of other olp code, e.g. ``git archive main | tar -x -C
+DIR``), ``load_krl`` of this code and of that code are also timed in fresh interpreters, one
+after the other on the same file (the machine's load drifts less between the two), and the
+ratio this / reference is printed. ``--only-load`` leaves out the lark references (at 1M lines
+they take minutes).
 """
 
 from __future__ import annotations
 
 import argparse
 import gc
+import os
 import random
+import subprocess
+import sys
 import tempfile
 import time
 from collections.abc import Callable
@@ -33,6 +42,44 @@ from lark import Lark
 from olp.frontends.krl import load_krl, parse_krl
 from olp.frontends.krl.parse import gc_paused
 from olp.resources import data_path
+
+REPO = Path(__file__).resolve().parents[1]
+CHILD = r"""
+import gc, sys, time
+import olp
+from olp.frontends.krl import load_krl
+best = float("inf")
+for _ in range(int(sys.argv[2])):
+    gc.collect()
+    start = time.perf_counter()
+    load_krl(sys.argv[1])
+    best = min(best, time.perf_counter() - start)
+print(f"@@ {best:.4f} {olp.__file__}")
+"""
+
+
+def child_load_krl(path: Path, repeats: int, code: Path | None) -> float:
+    """Best ``load_krl(path)`` time (s) in a fresh interpreter importing olp from ``code`` (this
+    checkout if None); the grammar is built in the first run, so ``repeats`` should be >= 2 for
+    small files."""
+    env = {**os.environ, "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
+    env["PYTHONPATH"] = str(code if code is not None else REPO)
+    done = subprocess.run(
+        [sys.executable, "-c", CHILD, str(path), str(repeats)],
+        capture_output=True,
+        text=True,
+        env=env,
+        check=False,
+        cwd=REPO.parent,
+    )
+    line = next((x for x in done.stdout.splitlines() if x.startswith("@@ ")), None)
+    if line is None:
+        raise SystemExit(f"load_krl failed in {code or REPO}:\n{done.stderr[-2000:]}")
+    seconds, imported = line.split()[1:]
+    expected = (code if code is not None else REPO).resolve()
+    if not Path(imported).resolve().is_relative_to(expected):
+        raise SystemExit(f"the child imported olp from {imported}, not from {expected}")
+    return float(seconds)
 
 
 def milling_program(lines: int, seed: int = 1) -> str:
@@ -76,27 +123,25 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--lines", type=int, default=20_000, help="LIN lines (default 20000)")
     parser.add_argument("--repeats", type=int, default=3, help="runs per measurement")
+    parser.add_argument("--reference", type=Path, default=None, help="other olp code to compare")
+    parser.add_argument("--only-load", action="store_true", help="leave out the lark references")
     args = parser.parse_args()
 
     text = milling_program(args.lines)
-    grammar = data_path("grammars", "krl.lark").read_text(encoding="utf-8")
-    bare = Lark(grammar, parser="lalr", propagate_positions=False, maybe_placeholders=True)
     parse_krl(milling_program(10), "warm.src")  # builds the grammars outside the timings
-    parse_krl(milling_program(10), "warm.src", fast_path=False)
-
+    times: dict[str, float] = {}
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / "milling.src"
         path.write_text(text, encoding="utf-8")
         result = load_krl(path)
         assert len(result.program) == args.lines + 1, "every LIN and the PTP are lowered"
-        times = {
-            "read_split": best_of(lambda: path.read_text(encoding="utf-8").split("\n"), 3),
-            "lark_no_positions": best_of(lambda: _without_gc(bare.parse, path.read_text()), 1),
-            "load_krl": best_of(lambda: load_krl(path), args.repeats),
-            "load_krl_without_fast_path": best_of(
-                lambda: parse_krl(path.read_text(), str(path), fast_path=False), 1
-            ),
-        }
+        times["read_split"] = best_of(lambda: path.read_text(encoding="utf-8").split("\n"), 3)
+        if not args.only_load:
+            times.update(_lark_references(path))
+        times["load_krl"] = best_of(lambda: load_krl(path), args.repeats)
+        if args.reference is not None:
+            times["reference_load_krl_child"] = child_load_krl(path, args.repeats, args.reference)
+            times["load_krl_child"] = child_load_krl(path, args.repeats, None)
 
     n = args.lines
     print(f"lin_lines: {n} lines")
@@ -106,6 +151,22 @@ def main() -> None:
     for name, seconds in times.items():
         if name != "load_krl":
             print(f"ratio_{name}_to_load_krl: {seconds / times['load_krl']:.3f} x")
+    if args.reference is not None:
+        ratio = times["load_krl_child"] / times["reference_load_krl_child"]
+        print(f"load_krl_{n}_lines: {times['load_krl_child']:.2f} s")
+        print(f"load_krl_vs_reference: {ratio:.3f} x")
+
+
+def _lark_references(path: Path) -> dict[str, float]:
+    grammar = data_path("grammars", "krl.lark").read_text(encoding="utf-8")
+    bare = Lark(grammar, parser="lalr", propagate_positions=False, maybe_placeholders=True)
+    parse_krl(milling_program(10), "warm.src", fast_path=False)
+    return {
+        "lark_no_positions": best_of(lambda: _without_gc(bare.parse, path.read_text()), 1),
+        "load_krl_without_fast_path": best_of(
+            lambda: parse_krl(path.read_text(), str(path), fast_path=False), 1
+        ),
+    }
 
 
 if __name__ == "__main__":

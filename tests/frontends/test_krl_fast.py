@@ -12,8 +12,8 @@ from hypothesis import strategies as st
 from olp import ir
 from olp.errors import ParseError
 from olp.frontends.krl import KrlData, KrlResult, load_config_dat, parse_dat, parse_krl
-from olp.frontends.krl.ast import FastMotion, Source
-from olp.frontends.krl.fast import materialise, scan_line
+from olp.frontends.krl.ast import FastMotion, LinRows, Source
+from olp.frontends.krl.fast import materialise, row_motions, scan_line
 from olp.frontends.krl.parse import parse_module
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
@@ -79,7 +79,8 @@ def test_lines_the_fast_path_leaves_to_the_grammar(line: str) -> None:
 def statements(text: str, fast: bool) -> list[object]:
     module = parse_module(Source.of(text, "t.src"), fast=fast)
     body = module.items[0].body
-    return [materialise(s) if isinstance(s, FastMotion) else s for s in body]
+    flat = [m for s in body for m in (row_motions(s) if isinstance(s, LinRows) else (s,))]
+    return [materialise(s) if isinstance(s, FastMotion) else s for s in flat]
 
 
 KEYWORDS = ["PTP", "LIN", "ptp", "Lin", "SPTP", "slin", "LIN_REL", "CIRC"]

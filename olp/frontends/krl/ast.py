@@ -11,6 +11,8 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import TypeAlias
 
+import numpy as np
+
 from olp import ir
 from olp.errors import ParseError
 
@@ -265,6 +267,30 @@ class FastMotion:
     text: str
 
 
+@dataclass(frozen=True, slots=True, eq=False)
+class LinRows:
+    """Consecutive lines ``LIN {X ..,Y ..,Z ..,A ..,B ..,C ..}`` (optionally `` C_DIS``), each
+    starting in column 1 and written exactly so (see :func:`olp.frontends.krl.fast.scan_rows`),
+    read as arrays.
+
+    ``values`` (N, 6): X, Y, Z (mm), A, B, C (deg) as written; ``approx`` (N,) bool: the row
+    ends in C_DIS; ``lines`` (N,) 1-based line numbers; ``ends`` (N,) each row's end column
+    (1-based, exclusive); ``texts`` the lines as written (for
+    :func:`olp.frontends.krl.fast.row_motions`, which gives the rows as :class:`FastMotion`
+    whenever the lowering needs more than the common case); ``span`` the first row's.
+    """
+
+    values: np.ndarray
+    approx: np.ndarray
+    lines: np.ndarray
+    ends: np.ndarray
+    texts: tuple[str, ...]
+    span: ir.SourceSpan
+
+    def __len__(self) -> int:
+        return len(self.texts)
+
+
 @dataclass(frozen=True, slots=True)
 class WaitSec:
     seconds: Expr
@@ -381,6 +407,7 @@ Stmt: TypeAlias = (
     | CallStmt
     | MotionStmt
     | FastMotion
+    | LinRows
     | WaitSec
     | WaitFor
     | Decl

@@ -29,6 +29,7 @@ from olp.frontends.krl.ast import (
     IgnoredLine,
     InterruptCtl,
     InterruptDecl,
+    LinRows,
     Module,
     MotionStmt,
     Other,
@@ -46,12 +47,12 @@ from olp.frontends.krl.data import OTHER_REASONS, KrlData, visible_globals
 from olp.frontends.krl.events import Events
 from olp.frontends.krl.flow import assigned_names, is_straight, jump_targets, statements, to_expr
 from olp.frontends.krl.motion import Motions
+from olp.frontends.krl.rows import build_instructions
 from olp.frontends.krl.state import (
     DEFAULT_VEL_CP,
     Context,
     KrlResult,
     State,
-    build_instructions,
     is_here,
 )
 from olp.frontends.krl.values import (
@@ -144,6 +145,7 @@ class _Lowering(Motions, Events):
         }
         self._statements: dict[type, Callable[[Any], None]] = {
             FastMotion: self._fast_motion,
+            LinRows: self._lin_rows,
             MotionStmt: self._motion_or_here,
             Assign: self._assign,
             CallStmt: self._call,
@@ -179,6 +181,9 @@ class _Lowering(Motions, Events):
             self.lower_statement(stmt)
 
     def lower_statement(self, stmt: Stmt) -> None:
+        if isinstance(stmt, LinRows):  # checks and spends per row itself
+            self._lin_rows(stmt)
+            return
         if self.returned is not None:
             routine, line = self.returned
             self._ignore(stmt, f"unreachable: {routine} returns at line {line}")
@@ -521,7 +526,7 @@ class _Lowering(Motions, Events):
     def _branch(self, body: Sequence[Stmt], loop: bool = False) -> tuple[_Lowering, Body]:
         child = self._child(loop)
         child.lower_body(body)
-        return child, build_instructions(child.out)
+        return child, build_instructions(child.out, dense=False)
 
     def _loop_body(self, body: Sequence[Stmt], keyword: str, span: ir.SourceSpan) -> Body:
         """A loop's body, lowered once from the state every pass may start with: variables it

@@ -1,7 +1,7 @@
 """KRL lowering of motions: PTP/LIN/CIRC, their spline and _REL forms, and the fast path.
 
 Targets are inline aggregates or named points; Cartesian ones stay KRL values (mm, deg) until
-:func:`olp.frontends.krl.state.build_instructions`. See :mod:`olp.frontends.krl` for the rules.
+:func:`olp.frontends.krl.rows.build_instructions`. See :mod:`olp.frontends.krl` for the rules.
 """
 
 from __future__ import annotations
@@ -17,16 +17,18 @@ from olp.frontends.krl.ast import (
     Aggregate,
     Expr,
     FastMotion,
+    LinRows,
     MotionStmt,
     StatusTurn,
     Var,
 )
-from olp.frontends.krl.fast import materialise
+from olp.frontends.krl.fast import materialise, row_motions
 from olp.frontends.krl.inline import InlineForms
 from olp.frontends.krl.state import (
     DEFAULT_VEL_CP,
     Cartesian,
     Pending,
+    PendingRows,
     Target,
 )
 from olp.frontends.krl.values import (
@@ -63,6 +65,46 @@ class Motions(InlineForms):
     """Motion statements -> IR motions, tracking where the robot goes."""
 
     # ---- the fast path
+    def _lin_rows(self, rows: LinRows) -> None:
+        """Rows of the CAM shape as one :class:`PendingRows` where each would take
+        :meth:`_lower_fast` with nothing to note; else line by line, as :class:`FastMotion`."""
+        if not self._takes_rows(rows):
+            for motion in row_motions(rows):
+                self.lower_statement(motion)  # type: ignore[attr-defined]
+            return
+        self.ctx.remaining -= len(rows)  # what lower_statement spends per line
+        state = self.state
+        zone = 0.0 if state.cdis_mm is None else state.cdis_mm / 1000.0
+        fields = {"speed": state.speed, "tool": state.tool, "frame": state.frame}
+        self.out.append(
+            PendingRows(
+                values=rows.values,
+                speeds=np.full(len(rows), state.speed.linear),
+                zones=np.where(rows.approx, zone, 0.0),
+                lines=rows.lines,
+                ends=rows.ends,
+                fields={**fields, "file": rows.span.file},
+            )
+        )
+        self.track.at_position(tuple(map(float, rows.values[-1])), int(rows.lines[-1]))
+
+    def _takes_rows(self, rows: LinRows) -> bool:
+        """Whether every row would be lowered by :meth:`_lower_fast` without a note, an
+        ignored line or an error (then the rows need no statement of their own)."""
+        state = self.state
+        return (
+            self.returned is None
+            and self.exiting is None
+            and getattr(self, "jumped", None) is None
+            and not getattr(self, "ambiguous", None)
+            and self.ctx.remaining >= len(rows)
+            and self._after_with is None
+            and state.ori_type == "VAR"
+            and state.vel_cp_set
+            and (state.cdis_mm is not None or not rows.approx.any())
+            and bool(np.isfinite(rows.values).all())
+        )
+
     def _fast_motion(self, stmt: FastMotion) -> None:
         """The common simple motion, lowered without building its full AST; anything less
         common goes through :meth:`_motion` with the materialised statement."""

@@ -45,7 +45,6 @@ from olp.frontends.krl.ast import (
     DeclItem,
     EnumValue,
     Expr,
-    FastMotion,
     Field,
     ForLoop,
     FuncCall,
@@ -69,7 +68,7 @@ from olp.frontends.krl.ast import (
     WaitFor,
     WaitSec,
 )
-from olp.frontends.krl.fast import scan_line, signed_number
+from olp.frontends.krl.fast import RowReader, row_match, scan_line, signed_number
 from olp.resources import data_path
 
 _FAST_RUN = "\x00"
@@ -143,7 +142,7 @@ class _ToAst(Transformer[Token, Module]):
     without DECL of a type that may not be declared so (:data:`DECL_FREE_TYPES`)."""
 
     def __init__(
-        self, filename: str, runs: dict[int, tuple[FastMotion, ...]], lines: Sequence[str] = ()
+        self, filename: str, runs: dict[int, tuple[Stmt, ...]], lines: Sequence[str] = ()
     ) -> None:
         super().__init__(visit_tokens=True)
         self._filename = filename
@@ -190,7 +189,7 @@ class _ToAst(Transformer[Token, Module]):
     def ENUM(self, token: Token) -> EnumValue:
         return EnumValue(token[1:], self._token_span(token))
 
-    def FAST_RUN(self, token: Token) -> tuple[FastMotion, ...]:
+    def FAST_RUN(self, token: Token) -> tuple[Stmt, ...]:
         return self._runs[token.line or 0]
 
     # ---- module and routines
@@ -232,7 +231,7 @@ class _ToAst(Transformer[Token, Module]):
         return tuple(statements)
 
     @_inline
-    def fast_run(self, meta: Meta, run: tuple[FastMotion, ...]) -> tuple[FastMotion, ...]:
+    def fast_run(self, meta: Meta, run: tuple[Stmt, ...]) -> tuple[Stmt, ...]:
         return run
 
     def args(self, children: list[Expr]) -> tuple[Expr, ...]:
@@ -522,29 +521,39 @@ def parse_module(source: Source, fast: bool = True) -> Module:
         raise
 
 
-def _parse(text: str, filename: str, runs: dict[int, tuple[FastMotion, ...]], fast: bool) -> Module:
+def _parse(text: str, filename: str, runs: dict[int, tuple[Stmt, ...]], fast: bool) -> Module:
     tree = _parser(fast).parse(text + "\n")
     return _ToAst(filename, runs, text.split("\n")).transform(tree)
 
 
-def _substitute_fast_runs(source: Source) -> tuple[str, dict[int, tuple[FastMotion, ...]]]:
+def _substitute_fast_runs(source: Source) -> tuple[str, dict[int, tuple[Stmt, ...]]]:
     """The text with each run of fast lines replaced by one placeholder (line numbers kept), and
-    the runs by the line of their placeholder."""
+    the runs by the line of their placeholder: :class:`FastMotion` statements, and
+    :class:`LinRows` for consecutive lines of the CAM shape."""
     lines = source.text.split("\n")
-    runs: dict[int, tuple[FastMotion, ...]] = {}
-    run: list[FastMotion] = []
-    filename = source.filename
+    runs: dict[int, tuple[Stmt, ...]] = {}
+    run: list[Stmt] = []
+    first = 0  # line of the current run's placeholder (0: no run)
+    rows = RowReader(source.filename)
+    matched, matched_lines = rows.matches.append, rows.lines.append
     for index, line in enumerate(lines):
-        fast = scan_line(line, index + 1, filename) if line else None
-        if fast is None:
-            if run:
-                runs[run[0].span.line] = tuple(run)
-                run = []
-            continue
-        lines[index] = "" if run else _FAST_RUN
-        run.append(fast)
-    if run:
-        runs[run[0].span.line] = tuple(run)
+        match = row_match(line)
+        if match is not None:
+            matched(match)  # RowReader.add, without a call per line
+            matched_lines(index + 1)
+        else:
+            fast = scan_line(line, index + 1, source.filename) if line else None
+            run.extend(rows.flush())
+            if fast is None:
+                if first:
+                    runs[first], run, first = tuple(run), [], 0
+                continue
+            run.append(fast)
+        lines[index] = "" if first else _FAST_RUN
+        first = first or index + 1
+    run.extend(rows.flush())
+    if first:
+        runs[first] = tuple(run)
     return "\n".join(lines), runs
 
 

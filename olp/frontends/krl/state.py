@@ -8,7 +8,8 @@ value helpers that raise located errors, and the assignments of system variables
 calls and loops) build on it, in that order.
 
 Cartesian targets are collected as KRL values (mm, deg) and converted to poses in one vectorised
-call at the end (:func:`build_instructions`), as milling programs have tens of thousands of them.
+call at the end (:func:`olp.frontends.krl.rows.build_instructions`), as milling programs have
+tens of thousands of them.
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
@@ -145,12 +146,35 @@ Target = ir.JointTarget | Cartesian
 
 @dataclass(frozen=True, slots=True)
 class Pending:
-    """A motion whose Cartesian target(s) get their poses in :func:`build_instructions`."""
+    """A motion whose Cartesian target(s) get their poses in
+    :func:`olp.frontends.krl.rows.build_instructions`."""
 
     make: Callable[..., ir.Instruction]
     target: Target
     via: Cartesian | None
     fields: dict[str, Any]
+
+
+@dataclass(frozen=True, slots=True)
+class PendingRows:
+    """A run of plain LIN motions read as arrays (see
+    :meth:`olp.frontends.krl.motion.Motions._lin_rows`).
+
+    ``values`` (N, 6): X, Y, Z (mm), A, B, C (deg) in ``fields["frame"]``; ``speeds`` (N,) m/s;
+    ``zones`` (N,) m; ``lines`` (N,) 1-based source lines; ``ends`` (N,) each row's end column
+    (exclusive, 1-based; every row starts in column 1). ``fields`` holds the speed (its linear
+    part is the first row's), tool, frame and file all rows share.
+    """
+
+    values: np.ndarray
+    speeds: np.ndarray
+    zones: np.ndarray
+    lines: np.ndarray
+    ends: np.ndarray
+    fields: dict[str, Any]
+
+    def __len__(self) -> int:
+        return int(self.values.shape[0])
 
 
 _F = TypeVar("_F", ir.Frame, ir.Tool)
@@ -323,7 +347,7 @@ class Core:
         self.variables = variables
         self.evaluator = Evaluator(variables, ctx.sources.snippet)
         self.data = DataOps(variables, self.evaluator, ctx.sources)
-        self.out: list[ir.Node | Pending] = []
+        self.out: list[ir.Node | Pending | PendingRows] = []
         self.ignored: list[IgnoredLine] = []
         self.notes: list[Note] = []
         self.status_turn: list[StatusTurn] = []
@@ -739,31 +763,3 @@ class Core:
 def element_span(element: Value, default: ir.SourceSpan) -> ir.SourceSpan:
     span = getattr(element, "span", None)
     return span if isinstance(span, ir.SourceSpan) else default
-
-
-def build_instructions(out: Sequence[ir.Node | Pending]) -> tuple[ir.Node, ...]:
-    """The instructions, with all Cartesian poses computed in one vectorised call."""
-    values = []
-    for item in out:
-        if isinstance(item, Pending):
-            assert isinstance(item.target, Cartesian)
-            values.append(item.target.values)
-            if item.via is not None:
-                values.append(item.via.values)
-    poses = iter(frame_to_pose(np.array(values, dtype=np.float64).reshape(-1, 6)))
-    built: list[ir.Node] = []
-    for item in out:
-        if not isinstance(item, Pending):
-            built.append(item)
-            continue
-        target = item.target
-        assert isinstance(target, Cartesian)
-        fields = dict(item.fields)
-        fields["target"] = ir.CartesianTarget(
-            pose=next(poses), config=target.config, name=target.name
-        )
-        if item.via is not None:
-            via = item.via
-            fields["via"] = ir.CartesianTarget(pose=next(poses), config=via.config, name=via.name)
-        built.append(item.make(**fields))
-    return tuple(built)
