@@ -475,13 +475,8 @@ class KukaPost(Post):
     def step_values(self, robot: Any, joints: Any) -> list[Mapping[str, Any]]:
         """Status and Turn of each motion's planned joints (N, 6) rad, and whether Turn cannot
         select them within ``robot``'s joint limits (:func:`olp.vendors.kuka.turn_ambiguous`)."""
-        q = np.asarray(joints, dtype=np.float64)
-        try:
-            status, turn = status_turn(robot, q)
-        except (TypeError, ValueError) as exc:
-            raise PostError(f"the KRL post cannot describe robot {robot.name!r}: {exc}") from exc
-        limits = robot.limits
-        ambiguous = turn_ambiguous(q, limits.lower, limits.upper)
+        columns = self.step_columns(robot, joints)
+        status, turn, ambiguous = (columns[k] for k in ("status", "turn", "turn_ambiguous"))
         rows = zip(status.tolist(), turn.tolist(), ambiguous.tolist(), strict=True)
         return [{"status": int(s), "turn": int(t), "turn_ambiguous": bool(a)} for s, t, a in rows]
 
