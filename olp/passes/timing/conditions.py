@@ -15,8 +15,8 @@ Evaluation is constant folding over :mod:`olp.ir_flow` expressions: a name holds
 assumption says, or the value of a constant declaration, or the initial value of a variable
 that no statement assigns; everything else (a variable the program assigns, a function's
 result, a sensor) is :data:`UNKNOWN`, and so is any expression over it that its known parts do
-not decide (``false and x`` is false, ``true or x`` true). olp does not follow assignments
-along a path.
+not decide (``false and x`` is false, ``true or x`` true). What the program's own assignments
+fix along a path is added by the walk (:mod:`.known`).
 """
 
 from __future__ import annotations
