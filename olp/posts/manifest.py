@@ -27,6 +27,10 @@ The manifest says::
                                       # false: a folder copied before olp wrote them, which
                                       # would write every block's body unconditionally; a post
                                       # that checks it stops on a program with control flow)
+    module_data: true                 # the templates place declarations by scope (module
+                                      # data in the data list, external names not declared);
+                                      # default false: a folder copied before, which a post
+                                      # that checks it refuses for a program with module data
     options: {...}                    # free-form: templates see them as `options`, and so does
                                       # the post class
 
@@ -69,6 +73,7 @@ class PostManifest:
     rows: bool = False
     accelerations: bool = False
     flow: bool = False
+    module_data: bool = False
 
 
 def load_manifest(folder: Path) -> PostManifest:
@@ -86,7 +91,8 @@ def load_manifest(folder: Path) -> PostManifest:
     frames_in = str(raw.get("frames_in", "world"))
     if frames_in not in FRAMES_IN:
         raise PostError(f"{path}: frames_in must be one of {', '.join(FRAMES_IN)}")
-    rows, accelerations, flow = (_flag(raw, key, path) for key in ("rows", "accelerations", "flow"))
+    keys = ("rows", "accelerations", "flow", "module_data")
+    rows, accelerations, flow, module_data = (_flag(raw, key, path) for key in keys)
     return PostManifest(
         name=str(raw.get("name", folder.name)),
         vendor=str(raw.get("vendor", "")),
@@ -102,6 +108,7 @@ def load_manifest(folder: Path) -> PostManifest:
         rows=rows,
         accelerations=accelerations,
         flow=flow,
+        module_data=module_data,
     )
 
 

@@ -46,6 +46,7 @@ from olp.frontends.krl.ast import (
 from olp.frontends.krl.data import OTHER_REASONS, KrlData, visible_globals
 from olp.frontends.krl.events import Events
 from olp.frontends.krl.flow import assigned_names, is_straight, jump_targets, statements, to_expr
+from olp.frontends.krl.module_data import with_module_data
 from olp.frontends.krl.motion import Motions
 from olp.frontends.krl.rows import build_instructions
 from olp.frontends.krl.state import (
@@ -758,6 +759,7 @@ def lower_module(
     for data_list in (dat, config):
         ignored.extend(data_list.ignored if data_list is not None else ())
     program = ir.Program(name=main.name, instructions=build_instructions(lowering.out), source=src)
+    program = with_module_data(program, dat, config, shared)
     return KrlResult(
         program=program,
         ignored=tuple(ignored),

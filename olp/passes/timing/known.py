@@ -74,7 +74,7 @@ class Known:
             if isinstance(node, f.Declare):
                 name = node.name.casefold()
                 self.types[name] = node.type_name.casefold()
-                if not node.exported:
+                if not node.exported and node.scope != "external":
                     self.local.add(name)
             elif isinstance(node, f.InterruptDecl):
                 self.enabled = False
