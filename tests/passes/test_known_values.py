@@ -235,3 +235,20 @@ def test_system_variables_are_never_learned(station: Station) -> None:
         start(), lin(2, -300), assign("$tmp_count", const(3)), for_to(name("$tmp_count"))
     )
     assert by_rule(paths_of(station, prog))
+
+
+def test_a_global_value_is_not_fixed_by_its_declaration(
+    station: Station, passes: dict[int, float]
+) -> None:
+    def declared(**flags: bool) -> ir.Declare:
+        return ir.Declare(name="n", type_name="INT", value=const(2), **flags)
+
+    own = program(declared(), start(), lin(2, -300), for_to(name("n")))
+    assert one(paths_of(station, own)) == pytest.approx(passes[2], rel=TOL)
+    # GLOBAL: another module may assign it between runs, so its declared value is not known.
+    shared = program(declared(exported=True), start(), lin(2, -300), for_to(name("n")))
+    assert by_rule(paths_of(station, shared))
+    constant = program(
+        declared(exported=True, constant=True), start(), lin(2, -300), for_to(name("n"))
+    )
+    assert one(paths_of(station, constant)) == pytest.approx(passes[2], rel=TOL)

@@ -213,7 +213,8 @@ class Environment:
 
 def environment(program_nodes: Iterable[Any], assumptions: Assumptions) -> Environment:
     """The environment of a program: ``assumptions`` over the values its declarations fix (a
-    constant, or a variable with an initial value that no statement assigns)."""
+    constant, or a variable with an initial value that no statement assigns and that no other
+    module can: not exported)."""
     nodes = list(f.leaves(program_nodes))
     assigned = {
         key
@@ -227,7 +228,12 @@ def environment(program_nodes: Iterable[Any], assumptions: Assumptions) -> Envir
     }
     fixed: dict[str, Value] = {}
     for n in nodes:
-        if isinstance(n, f.Declare) and not n.dims and n.name.casefold() not in assigned:
+        if (
+            isinstance(n, f.Declare)
+            and not n.dims
+            and (n.constant or not n.exported)  # another module may assign a GLOBAL one
+            and n.name.casefold() not in assigned
+        ):
             value = Environment({}, fixed).evaluate(n.value)
             if not isinstance(value, _Unknown):
                 fixed[n.name.casefold()] = value
