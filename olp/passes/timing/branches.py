@@ -476,7 +476,7 @@ class _Walk:
 
     def choose(self, node: ir.If | ir.Switch, states: States) -> States:
         env = self.known.environment()
-        arms = _if_arms(node, env) if isinstance(node, ir.If) else _case_arms(node, env)
+        arms = if_arms(node, env) if isinstance(node, ir.If) else case_arms(node, env)
         self.known.evaluated(node)
         open_choice = sum(1 for _, taken in arms if taken) > 1
         out: States = {}
@@ -499,32 +499,10 @@ class _Walk:
     # ---- loops
 
     def passes(self, node: Any, label: str | None, counted: int | None) -> tuple[int, bool]:
-        """How many passes loop ``node`` runs (see the module docstring), and whether that is
-        the rule for a count olp does not know; ``counted``: the passes its counters give
-        (:meth:`Known.passes`)."""
-        file = node.span.file.replace("\\", "/").rsplit("/", 1)[-1].casefold()
-        keys: list[LoopKey] = [(file, node.span.line), node.span.line]
-        keys += [label.casefold()] if label else []
-        for key in keys:
-            if key in self.assumptions.loops:
-                self.used_loops.add(key)
-                count = self.assumptions.loops[key]
-                if isinstance(node, ir.Repeat) and count < 1:
-                    where = f"the REPEAT at line {node.span.line}"
-                    raise UsageError(
-                        f"--assume loop:{_loop_text(key)}={count}: {where} runs at least once"
-                    )
-                return count, False
-        env = self.known.environment()
-        if isinstance(node, ir.For):
-            bounded = _for_count(node, env)
-            if bounded is not None:
-                return bounded, False
-        if counted is not None:
-            return counted, False
-        if isinstance(node, ir.While) and env.evaluate(node.condition) is False:
-            return 0, False
-        return 1, True
+        """:func:`loop_passes` of ``node`` here."""
+        return loop_passes(
+            node, label, counted, self.assumptions, self.known.environment(), self.used_loops
+        )
 
     def repeat(self, node: Any, states: States, passes: int) -> tuple[States, bool]:
         """The states after ``passes`` passes of loop ``node`` (or an exit during one), and
@@ -564,7 +542,43 @@ class _Walk:
         return _merged(current, exits), bool(current) and passes > 0
 
 
-def _if_arms(node: ir.If, env: Environment) -> list[tuple[str, bool]]:
+def loop_passes(
+    node: Any,
+    label: str | None,
+    counted: int | None,
+    assumptions: Assumptions,
+    env: Environment,
+    used: set[LoopKey],
+) -> tuple[int, bool]:
+    """How many passes loop ``node`` runs (see the module docstring), and whether that is the
+    rule for a count olp does not know; ``label``: the label just before it; ``counted``: the
+    passes its counters give (:meth:`Known.passes`); an assumption that names it goes into
+    ``used``."""
+    file = node.span.file.replace("\\", "/").rsplit("/", 1)[-1].casefold()
+    keys: list[LoopKey] = [(file, node.span.line), node.span.line]
+    keys += [label.casefold()] if label else []
+    for key in keys:
+        if key in assumptions.loops:
+            used.add(key)
+            count = assumptions.loops[key]
+            if isinstance(node, ir.Repeat) and count < 1:
+                where = f"the REPEAT at line {node.span.line}"
+                raise UsageError(
+                    f"--assume loop:{_loop_text(key)}={count}: {where} runs at least once"
+                )
+            return count, False
+    if isinstance(node, ir.For):
+        bounded = _for_count(node, env)
+        if bounded is not None:
+            return bounded, False
+    if counted is not None:
+        return counted, False
+    if isinstance(node, ir.While) and env.evaluate(node.condition) is False:
+        return 0, False
+    return 1, True
+
+
+def if_arms(node: ir.If, env: Environment) -> list[tuple[str, bool]]:
     """(text, may run) per body of ``node`` (its branches, then its else)."""
     arms, decided = [], False
     for k, branch in enumerate(node.branches):
@@ -578,7 +592,7 @@ def _if_arms(node: ir.If, env: Environment) -> list[tuple[str, bool]]:
     return arms
 
 
-def _case_arms(node: ir.Switch, env: Environment) -> list[tuple[str, bool]]:
+def case_arms(node: ir.Switch, env: Environment) -> list[tuple[str, bool]]:
     subject = env.evaluate(node.subject)
     arms, decided = [], False
     for case in node.cases:
