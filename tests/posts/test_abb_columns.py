@@ -19,6 +19,7 @@ from olp.frontends.bundled import CsvOptions
 from olp.posts import find_post
 from olp.posts.abb import AbbPost, first_uses
 from olp.posts.base import Post
+from olp.posts.rows import spell_column
 from olp.posts.view import ProgramView
 from olp.vendors.abb import confdata
 from tests.posts.test_row_columns import _forbidden, _toolpath
@@ -274,3 +275,20 @@ def test_the_speed_names_of_columns_are_those_of_speed_name(tmp_path: Path) -> N
     assert columns.ok, [d.format() for d in columns.diagnostics if d.severity == "error"]
     assert columns.files == template.files
     assert ", v100, " in "".join(columns.files.values())
+
+
+@pytest.mark.parametrize("decimals", [6, 7, 9, 10, 11])
+def test_many_decimals_are_spelled_as_each_number_is(decimals: int) -> None:
+    """Decimals beyond the one-table look-up (ABB's quaternions: 9) are spelled in two parts."""
+    rng = np.random.default_rng(decimals)
+    values = np.concatenate(
+        [
+            rng.uniform(-1.0, 1.0, 20_000),
+            np.round(rng.uniform(-1.0, 1.0, 5_000), decimals),
+            np.round(rng.normal(0.0, 100.0, 5_000), decimals - 1) + 0.5 * 10.0**-decimals,
+            [0.0, -0.0, 1.0, -1.0, 1e-12, -1e-12, 0.5, 10.0**-decimals],
+        ]
+    )
+    expected = [f"{v:.{decimals}f}" for v in values.tolist()]
+    expected = [t[1:] if t.startswith("-") and float(t) == 0.0 else t for t in expected]
+    assert spell_column(values, decimals).tolist() == expected
