@@ -14,13 +14,13 @@ import pytest
 
 import olp
 from olp import ir
-from olp.compiled import CompiledProgram, PathBlock, items_of
+from olp.compiled import BlockRows, CompiledProgram, PathBlock, items_of
 from olp.frontends.bundled import CsvOptions
 from olp.posts import find_post
 from olp.posts.abb import AbbPost, first_uses
 from olp.posts.base import Post
 from olp.posts.rows import spell_column
-from olp.posts.view import ProgramView
+from olp.posts.view import Names, ProgramView, RowColumns
 from olp.vendors.abb import confdata
 from tests.posts.test_row_columns import _forbidden, _toolpath
 
@@ -64,6 +64,8 @@ def test_confdata_columns_are_the_confdata_of_each_step(cell: Path) -> None:
 
 
 def test_a_row_of_columns_is_the_step_the_templates_see(tmp_path: Path) -> None:
+    """:meth:`RowColumns.at` (the step of an error's row) holds the confdata as
+    :meth:`AbbPost.step_values` gives it: a tuple of four integers."""
     program = _toolpath(50, tmp_path)
     station = olp.load_station(KR6_CELL)
     post = find_post("abb")
@@ -71,11 +73,13 @@ def test_a_row_of_columns_is_the_step_the_templates_see(tmp_path: Path) -> None:
     view = ProgramView(compiled, post)
     flat = ProgramView(compiled.flat(), post)
     (block,) = [b for b in items_of(compiled.steps) if isinstance(b, PathBlock)]
-    motions = view.blocks[block.start]
+    allocation = view.allocate(Names(post.NAME_RULE, ()))
+    (rows,) = view.unit_steps([BlockRows(block, 0, len(block))], allocation)
+    assert isinstance(rows, RowColumns)
     for k in (0, 17, len(block) - 1):
         expected = flat.motions[block.start + k].vendor
-        got = {key: tuple(v[k].tolist()) for key, v in motions.columns.items()}
-        assert got == expected
+        assert rows.at(k).vendor == expected
+        assert isinstance(expected["confdata"], tuple) and len(expected["confdata"]) == 4
 
 
 # --------------------------------------------------------------------------------------------
