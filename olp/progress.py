@@ -123,6 +123,15 @@ def advance(count: int) -> None:
         reporter.advance(count)
 
 
+def note(name: str, seconds: float) -> None:
+    """A finished line ``name  in 1.2 s`` for work timed elsewhere (the stages of a streamed
+    build, which run window by window inside one stage)."""
+    reporter = _REPORTER.get()
+    if reporter is not None:
+        reporter.stream.write(f"\r\033[K  {name:<9} {seconds:.1f} s\n")
+        reporter.stream.flush()
+
+
 def terminal_reporter(quiet: bool, stream: TextIO | None = None) -> Reporter | None:
     """A reporter on standard error when a person watches it: a terminal, no ``--quiet``, and
     not under CI (the ``CI`` variable that CI services set)."""
