@@ -308,6 +308,7 @@ class StreamedRender:
         for cut in self.counter.rows(len(block)):
             if cut > lo:
                 self._rows(BlockRows(block, lo, cut), motions)
+            _close(self.parts[-1])
             self.parts.append(_Part())
             lo = cut
         self._rows(BlockRows(block, lo, len(block)), motions)
@@ -440,9 +441,7 @@ class StreamedRender:
         for numbers that cannot be written (nothing is then to be committed)."""
         post = self.post
         for part in self.parts:
-            for call in part.calls:
-                if call.handle is not None:
-                    call.handle.close()
+            _close(part)
         if post.problems:
             raise RenderError(_unique(post.problems))
         if not self.rows_started:
@@ -621,6 +620,14 @@ class StreamedRender:
                     shutil.copyfileobj(source, handle, 1 << 20)
                 body.unlink()
                 handle.write(self._encode(pieces[k + 1], fname))
+
+
+def _close(part: _Part) -> None:
+    """Close the scratch files of a part whose rows are all written."""
+    for call in part.calls:
+        if call.handle is not None:
+            call.handle.close()
+            call.handle = None
 
 
 def _stand_in(rows: RowColumns) -> SplicedRows:
