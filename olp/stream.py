@@ -232,7 +232,8 @@ def build_streamed(
 
             writer = StreamedRender(post, staged, station, program_name, str(path))
             run = _Run(station, options, post, writer, findings, totals, clock)
-            with progress.stage("build", count_lines(path), "rows"):
+            estimate = count_lines(path) - windows.layout.header_rows
+            with progress.stage("build", estimate, "rows"):
                 run.all(windows)
         if not findings.errors:
             try:
@@ -245,7 +246,7 @@ def build_streamed(
     finally:
         staged.discard()
     for stage, seconds in clock.seconds.items():
-        progress.note(stage, seconds)
+        progress.note(stage, seconds, totals.instructions)
     diagnostics = findings.all()
     summary = StreamSummary(
         totals.instructions,

@@ -178,3 +178,21 @@ def test_the_cli_streams_with_chunk_rows(tmp_path: Path) -> None:
     assert names == sorted(os.listdir(tmp_path / "b"))
     for name in names:
         assert (tmp_path / "a" / name).read_bytes() == (tmp_path / "b" / name).read_bytes()
+
+
+def test_progress_shows_the_build_and_each_stage_with_its_rate(
+    station: olp.Station, tmp_path: Path
+) -> None:
+    import io
+
+    from olp import progress
+
+    csv = helix_csv(tmp_path / "helix.csv", 3_000)
+    shown = io.StringIO()
+    with progress.showing(progress.Reporter(shown)):
+        out = tmp_path / "out"
+        olp.build(station, csv, "kuka", out, program_options=options(), chunk_rows=WINDOW)
+    lines = [line.rsplit("\r\033[K", 1)[-1] for line in shown.getvalue().split("\n")]
+    assert any(line.startswith("build") and "rows/s" in line for line in lines)
+    for stage in ("read", "resolve", "collide", "time", "write"):
+        assert any(line.split()[:1] == [stage] and "3,000 rows in" in line for line in lines)

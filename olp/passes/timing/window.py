@@ -131,10 +131,8 @@ class WindowTimer:
         before = self._before if _starts_with_block(items) else []
         after: list[Item] = []
         if _blends_out(items) and _starts_with_block(following):
-            head = following[0]
-            assert isinstance(head, PathBlock)
-            after = [block_rows(head, 0, travel_rows(head, self._reach(head), False), 0)]
-        self._before = self._tail(items) if _blends_out(items) else []
+            after = self._context(following, from_end=False)
+        self._before = self._context(items, from_end=True) if _blends_out(items) else []
         if not before and not after:
             return time_program(window, self.other_times, self.options)
         return self._with_context(window, items, before, after)
@@ -144,12 +142,32 @@ class WindowTimer:
         speed = float(np.max(block.node.speeds))
         return max(self.context_m, speed * speed / self.accel)
 
-    def _tail(self, items: Sequence[Item]) -> list[Item]:
-        """The last rows of a window, as context for the next one."""
-        last = items[-1]
-        assert isinstance(last, PathBlock)
-        count = travel_rows(last, self._reach(last), True)
-        return [block_rows(last, len(last) - count, len(last), 0)]
+    def _context(self, items: Sequence[Item], from_end: bool) -> list[Item]:
+        """Rows next to a boundary, from the resolved blocks at the end (``from_end``) or the
+        start of ``items``, covering the context's TCP travel; their instruction indices
+        from 0, in order."""
+        order = reversed(items) if from_end else iter(items)
+        taken: list[PathBlock] = []
+        left = None
+        for item in order:
+            if not isinstance(item, PathBlock) or item.path is None:
+                break
+            reach = self._reach(item) if left is None else left
+            count = travel_rows(item, reach, from_end)
+            lo, hi = (len(item) - count, len(item)) if from_end else (0, count)
+            taken.append(block_rows(item, lo, hi, 0))
+            positions = item.node.poses[lo:hi, :3, 3]
+            left = reach - float(np.sum(np.linalg.norm(np.diff(positions, axis=0), axis=-1)))
+            if count < len(item) or left <= 0.0:
+                break
+        if from_end:
+            taken.reverse()
+        out: list[Item] = []
+        start = 0
+        for block in taken:
+            out.append(shifted(block, start))
+            start += len(block)
+        return out
 
     def _with_context(
         self,
