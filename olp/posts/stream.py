@@ -21,10 +21,13 @@ that stand-in (the post's row writers: ``krl_rows``, ``krl_rows_dat``, ...) is i
 
 The text is the one :func:`olp.posts.render.render` writes, byte for byte, for a post whose
 templates write a run of toolpath rows as the row writer's output per rows item and nothing
-between two rows items (the bundled posts do), whose ``vendor`` context does not depend on
+between two rows items and computes nothing else in a file from its rows (it says so:
+:attr:`~olp.posts.base.Post.STREAMS`; KUKA's do), whose ``vendor`` context does not depend on
 the rows (:meth:`~olp.posts.base.Post.context_values` not overridden), without ``TRANSFORMS``
 (they may look across a window boundary) and without a ``max_lines_per_file`` limit (it needs
-the whole text): :func:`streams`. ``tests/test_stream.py`` compares both builds.
+the whole text): :func:`streams`. ``tests/test_stream.py`` compares both builds. A template
+that writes a part's rows other than through a filter applied to its rows item is a
+PostError, not a file with one row.
 
 Names: point names of toolpath rows follow the post's ``point_names`` pattern without being
 kept in memory; the few names taken besides them (the program's, its parts', tools, frames,
@@ -85,7 +88,8 @@ def streams(post: Post) -> bool:
     """Whether ``post`` can write a streamed toolpath (see the module text)."""
     manifest = post.manifest
     return (
-        post.COLUMNS
+        post.STREAMS
+        and post.COLUMNS
         and post.rows_enabled()
         and not post.TRANSFORMS
         and type(post).context_values is Post.context_values
@@ -412,6 +416,12 @@ class StreamedRender:
                 render_templates(self.post, self.env, [(template, pattern)], context)
         finally:
             self.splicer.recording = None
+        if not calls:
+            raise PostError(
+                f"post {self.manifest.name!r}: no template writes the toolpath's rows through a "
+                "row writer filter applied to them, so they cannot be streamed: build the "
+                "program whole (olp build --chunk-rows 0)"
+            )
         for call in calls:
             call.handle = open(call.body, "wb")  # noqa: SIM115 - closed in finish()
         return calls
