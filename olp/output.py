@@ -174,7 +174,10 @@ class StagedFolder:
     def add(self, name: str, data: bytes) -> None:
         """A new file ``name`` of the set holding ``data``, written and flushed at once."""
         self._claim(name)
-        _write_new(self._folder() / name, data)
+        try:
+            _write_new(self._folder() / name, data)
+        except OSError as exc:
+            raise UsageError(f"cannot write {self.target}: {exc.strerror or exc}") from exc
 
     def scratch(self) -> Path:
         """A fresh hidden working file in the staging folder (not part of the set); the
