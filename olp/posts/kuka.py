@@ -456,6 +456,7 @@ class KukaPost(Post):
     ARC_ANGLE = True
     ROWS = True
     COLUMNS = True
+    STREAMS = True
 
     def step_columns(self, robot: Any, joints: Any) -> Mapping[str, Any]:
         """:meth:`step_values` as arrays (N,)."""
