@@ -225,14 +225,22 @@ def test_the_blend_radii_filter_reads_a_toolpath_as_columns(tmp_path: Path) -> N
     assert len(_blends_filter(post, items, station)) == len(motions) > 50
 
 
-@pytest.mark.parametrize("decimals", [6, 7, 8])
-def test_six_to_eight_decimals_are_spelled_as_python_spells_them(decimals: int) -> None:
+@pytest.mark.parametrize("decimals", range(9))
+def test_numbers_at_and_next_to_ties_are_spelled_as_python_spells_them(decimals: int) -> None:
+    """Columns of 6 to 8 decimals (UR's positions) take another way through the tables; and a
+    value whose product with ``10**decimals`` rounds to a half is rounded by the product's
+    exact error (CSV coordinates in mm with 4 decimals are such halves in metres)."""
     rng = np.random.default_rng(11)
+    ties = np.round(rng.normal(0.0, 10.0, 10_000), decimals) + 0.5 * 10.0**-decimals
+    mm = np.round(rng.normal(0.0, 300.0, 10_000), 4) / 1000.0
     values = np.concatenate(
         [
-            rng.normal(0.0, 2.0, 20_000),
-            np.round(rng.normal(0.0, 1.0, 5000), decimals) + 0.5 * 10.0**-decimals,
-            [0.0, -0.0, -4e-9, 1e-9, 123.4567895],
+            rng.normal(0.0, 2.0, 10_000),
+            ties,
+            np.nextafter(ties, np.inf),
+            np.nextafter(ties, -np.inf),
+            mm,
+            [0.0, -0.0, -4e-9, 1e-9, 123.4567895, 0.5, -0.5, 2.5, -2.5],
         ]
     )
     expected = [f"{v:.{decimals}f}" for v in values.tolist()]
