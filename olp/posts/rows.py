@@ -204,19 +204,28 @@ _SMALL = 1 << 17
 
 @functools.cache
 def _small_integers() -> NDArray[np.str_]:
-    return np.array([str(k) for k in range(_SMALL)])
+    """``0`` ... ``131071``: below 1000 as Python spells them, then each thousand's number
+    followed by three digits (the table made of tables, without a Python string per entry)."""
+    thousands = np.array([str(k) for k in range(1, -(-_SMALL // 1000))])
+    above = np.strings.add(thousands[:, None], _digits(3)[None, :]).ravel()
+    below = np.array([str(k) for k in range(1000)], dtype=above.dtype)
+    return np.concatenate([below, above])[:_SMALL]
 
 
 @functools.cache
 def _fractions(decimals: int) -> NDArray[np.str_]:
     """``.000`` ... ``.999`` for ``decimals`` 3: the point and the digits of every fraction."""
-    return np.array([f".{k:0{decimals}d}" for k in range(10**decimals)])
+    return np.strings.add(".", _digits(decimals))
 
 
 @functools.cache
 def _digits(count: int) -> NDArray[np.str_]:
-    """``000`` ... ``999`` for ``count`` 3: every ``count``-digit string, zero-padded."""
-    return np.array([f"{k:0{count}d}" for k in range(10**count)])
+    """``000`` ... ``999`` for ``count`` 3: every ``count``-digit string, zero-padded, in
+    order (made digit by digit from the shorter table, without a Python string per entry)."""
+    one = np.array(list("0123456789"))
+    if count == 1:
+        return one
+    return np.strings.add(one[:, None], _digits(count - 1)[None, :]).ravel()
 
 
 def _integers(values: NDArray[np.int64]) -> NDArray[np.str_]:
