@@ -246,3 +246,11 @@ def test_numbers_at_and_next_to_ties_are_spelled_as_python_spells_them(decimals:
     expected = [f"{v:.{decimals}f}" for v in values.tolist()]
     expected = [t[1:] if t.startswith("-") and float(t) == 0.0 else t for t in expected]
     assert spell_column(values, decimals).tolist() == expected
+
+
+def test_every_entry_of_the_spelling_tables_is_python_s_spelling() -> None:
+    """The integers and fractions the column spelling looks up (made from tables of digits)."""
+    whole = np.arange(140_000, dtype=np.float64)
+    assert spell_column(whole, 0).tolist() == [str(k) for k in range(140_000)]
+    fifths = np.arange(100_000) / 1e5 + 7.0
+    assert spell_column(fifths, 5).tolist() == [f"{v:.5f}" for v in fifths.tolist()]
