@@ -96,17 +96,19 @@ def _spelled(v: FloatArray, decimals: int, compact: bool) -> tuple[NDArray[np.st
     ``compact`` drops trailing zeros and a bare point), formatted as integers with numpy.
 
     A value times ``10**decimals`` is rounded to the nearest integer, which is what Python's
-    correctly rounded formatting gives unless the product lies within its own rounding error
-    of a half (or is too large for exact integers, or not finite): those few values are
-    spelled by Python itself.
+    correctly rounded formatting gives: the rounded product lies on the same side of a half
+    as the exact one, unless it is the half itself; then the product's rounding error says
+    which side (:func:`_half_rounded`). Values too large for exact integers, or not finite,
+    are spelled by Python itself.
     """
     scale = 10.0**decimals
     with np.errstate(invalid="ignore", over="ignore"):
         p = v * scale
         r = np.rint(p)
-        frac = np.abs(p - np.trunc(p))
-        tol = np.maximum(1e-6, 8.0 * np.finfo(np.float64).eps * np.abs(p))
-        slow = ~(np.abs(p) < 2.0**50) | (np.abs(frac - 0.5) <= tol)
+        slow = ~(np.abs(p) < 2.0**50)
+        half = np.abs(p - np.trunc(p)) == 0.5
+    if np.any(half):
+        r[half] = _half_rounded(v[half], scale, p[half])
     r[slow] = 0.0
     whole = np.abs(r).astype(np.int64)
     if decimals == 0:
@@ -138,6 +140,35 @@ def _spelled(v: FloatArray, decimals: int, compact: bool) -> tuple[NDArray[np.st
     if np.any(slow):
         printed[slow] = [float(t) for t in exact]
     return text, printed
+
+
+def _half_rounded(v: FloatArray, scale: float, p: FloatArray) -> FloatArray:
+    """The integers nearest to the exact products ``v * scale`` whose rounded products ``p``
+    are halves (``k + 0.5``, ``|p| < 2**50``): above the half where the product's rounding
+    error is positive, below where it is negative, and an exact half to even (as Python's
+    formatting, and :func:`numpy.rint`, round it)."""
+    error = _product_error(v, scale, p)
+    low = np.floor(p)
+    return np.where(error > 0.0, low + 1.0, np.where(error < 0.0, low, np.rint(p)))
+
+
+_SPLIT = 134217729.0
+"""2**27 + 1: Veltkamp's splitting constant for doubles."""
+
+
+def _product_error(a: FloatArray, b: float, p: FloatArray) -> FloatArray:
+    """``a * b - p`` exactly, where ``p`` is the rounded product ``a * b`` (Dekker's exact
+    product: each factor split into halves of 26 bits, whose products are exact; no
+    overflow below 2**995, no underflow for products above 2**-969)."""
+
+    def halves(x: Any) -> tuple[Any, Any]:
+        c = _SPLIT * x
+        high = c - (c - x)
+        return high, x - high
+
+    a_high, a_low = halves(a)
+    b_high, b_low = halves(np.float64(b))
+    return ((a_high * b_high - p) + a_high * b_low + a_low * b_high) + a_low * b_low
 
 
 def number_column(values: ArrayLike, fmt: NumberFormat) -> tuple[NDArray[np.str_], bool]:
@@ -173,19 +204,28 @@ _SMALL = 1 << 17
 
 @functools.cache
 def _small_integers() -> NDArray[np.str_]:
-    return np.array([str(k) for k in range(_SMALL)])
+    """``0`` ... ``131071``: below 1000 as Python spells them, then each thousand's number
+    followed by three digits (the table made of tables, without a Python string per entry)."""
+    thousands = np.array([str(k) for k in range(1, -(-_SMALL // 1000))])
+    above = np.strings.add(thousands[:, None], _digits(3)[None, :]).ravel()
+    below = np.array([str(k) for k in range(1000)], dtype=above.dtype)
+    return np.concatenate([below, above])[:_SMALL]
 
 
 @functools.cache
 def _fractions(decimals: int) -> NDArray[np.str_]:
     """``.000`` ... ``.999`` for ``decimals`` 3: the point and the digits of every fraction."""
-    return np.array([f".{k:0{decimals}d}" for k in range(10**decimals)])
+    return np.strings.add(".", _digits(decimals))
 
 
 @functools.cache
 def _digits(count: int) -> NDArray[np.str_]:
-    """``000`` ... ``999`` for ``count`` 3: every ``count``-digit string, zero-padded."""
-    return np.array([f"{k:0{count}d}" for k in range(10**count)])
+    """``000`` ... ``999`` for ``count`` 3: every ``count``-digit string, zero-padded, in
+    order (made digit by digit from the shorter table, without a Python string per entry)."""
+    one = np.array(list("0123456789"))
+    if count == 1:
+        return one
+    return np.strings.add(one[:, None], _digits(count - 1)[None, :]).ravel()
 
 
 def _integers(values: NDArray[np.int64]) -> NDArray[np.str_]:

@@ -64,16 +64,16 @@ Conventions shared with frontends (rotation vectors, the flange, no configuratio
 
 from __future__ import annotations
 
-import dataclasses
 import itertools
 import re
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from olp import ir
+from olp.compiled import PathBlock, StepBlocks, items_of, span_of
 from olp.diagnostics import Diagnostic
 from olp.ir import ArcOrientation
 from olp.ir_flow import bodies
@@ -87,10 +87,12 @@ from olp.posts.flow_text import (
     flow_problems,
 )
 from olp.posts.numbers import NumberFormat
+from olp.posts.rows import PostRows, number_column
 from olp.posts.sandbox import SafeText
 from olp.posts.text import NUMBER, ArgumentRule, CommentRule, NameRule
 from olp.posts.ur_flow import UrWriter
-from olp.transforms.blend import with_step_instructions
+from olp.posts.view import RowColumns
+from olp.transforms.blend import with_radii
 from olp.vendors.ur import (
     MOTION_DECIMALS,
     movej_parameters,
@@ -99,9 +101,9 @@ from olp.vendors.ur import (
 )
 
 if TYPE_CHECKING:
-    from olp.compiled import CompiledProgram
-    from olp.posts.rows import PostRows
+    from olp.compiled import CompiledProgram, Step
     from olp.posts.view import PostStep
+    from olp.span import SourceSpan
 
 _KEYWORDS = """
 def end if elif else while for return thread run kill halt break continue pass global local
@@ -193,12 +195,15 @@ def seconds(post: Post, value: float) -> str:
     return post.number("sleep", value)
 
 
-def ur_rows(post: Post, rows: PostRows) -> SafeText:
+def ur_rows(post: Post, rows: PostRows | RowColumns) -> SafeText:
     """The lines of a run of ``movel`` (:mod:`olp.posts.rows`), exactly as
     ``program.script.j2`` writes each: ``set_tcp`` where the tool changes, then
     ``movel(p[..], a=.., v=.., r=..)`` with the target in the robot's Base frame. Poses, speeds
-    and radii are formatted as columns; every piece is a checked number, so the lines are
+    and radii are formatted as columns (a toolpath's rows as :class:`RowColumns`: no object per
+    row, :func:`_column_lines`); every piece is a checked number, so the lines are
     :class:`~olp.posts.sandbox.SafeText`."""
+    if isinstance(rows, RowColumns):
+        return SafeText(_column_lines(post, rows))
     steps = rows.steps
     v = pose_to_ur(np.stack([s.base_pose for s in steps]))  # type: ignore[misc]
     xyz = post.number_column("position", v[:, :3], steps)
@@ -222,6 +227,54 @@ def ur_rows(post: Post, rows: PostRows) -> SafeText:
     return SafeText("\n".join(lines))
 
 
+def _column_lines(post: Post, rows: RowColumns) -> str:
+    """:func:`ur_rows` of a toolpath's rows as columns: the targets in the robot's Base frame
+    (``frame_pose @ pose``, as the view computes each step's ``base_pose``), ``a`` (one value:
+    the block's path acceleration), ``v`` and ``r`` spelled as whole columns; ``set_tcp``
+    before the first row where the tool changes. A number that cannot be written is an error
+    on its own row, reported in the order the template would report it (row by row)."""
+    at = rows.at
+    since = len(post.problems)
+    head = []
+    if rows.new_tool:
+        post.current_step = at(0)
+        head.append(f"  set_tcp({ur_pose(post, rows.tool_item.pose)})")
+    v = pose_to_ur(rows.motions.frame_pose @ rows.poses)
+    xyz = post.number_texts("position", v[:, :3], at)
+    rot = post.number_texts("angle", v[:, 3:], at)
+    accel = movel_parameters(1.0, rows.node.acceleration, False)[0]
+    a = _constant_texts(post, "acceleration", accel, len(rows), at)
+    speeds = post.number_texts("speed", rows.speeds, at)
+    radii = post.number_texts("radius", rows.zones, at)
+    post.current_step = rows
+    _in_row_order(post, since)
+    columns = (xyz[:, 0], xyz[:, 1], xyz[:, 2], rot[:, 0], rot[:, 1], rot[:, 2], speeds, radii)
+    lines = [
+        f"  movel(p[{x}, {y}, {z}, {rx}, {ry}, {rz}], a={a}, v={s}, r={r})"
+        for x, y, z, rx, ry, rz, s, r in zip(*(c.tolist() for c in columns), strict=True)
+    ]
+    return "\n".join([*head, *lines])
+
+
+def _constant_texts(
+    post: Post, quantity: str, value: float, n: int, at: Callable[[int], PostStep]
+) -> str:
+    """``value`` spelled once for ``n`` rows; where it cannot be written, the error on every
+    row (as the template reports it on each)."""
+    texts, ok = number_column(np.array([value]), post.NUMBERS[quantity])
+    if ok:
+        return str(texts[0])
+    return str(post.number_texts(quantity, np.full(n, value), at)[0])
+
+
+def _in_row_order(post: Post, since: int) -> None:
+    """The problems found since ``since`` ordered by instruction (stable: within a row, in the
+    order of its line's numbers), as a template writing row by row finds them."""
+    found = post.problems[since:]
+    found.sort(key=lambda d: -1 if d.index is None else d.index)
+    post.problems[since:] = found
+
+
 def _via_filter(post: Post, step: PostStep) -> str:
     """Template filter: ``s | ur_via``, the ``p[...]`` of a circle's via point in the robot's
     Base frame (the post's ``frames_in: robot_base`` makes ``frame_pose`` relative to it)."""
@@ -240,10 +293,19 @@ def _blends_filter(post: Post, steps: Any, station: Any) -> dict[int, float]:
     radius in m (:func:`olp.transforms.blend.blend_radii`, from the robot's home joints). The
     bundled template writes the zone radius, which :class:`UrPost`'s transform already capped;
     folders made before keep working."""
-    from olp.transforms.blend import blend_radii
+    from olp.transforms.blend import blend_columns
 
+    items: list[Any] = []
+    for s in steps:
+        if isinstance(s, RowColumns):
+            items.append(s.piece)  # a toolpath's rows, as arrays
+        elif isinstance(s, PostRows):
+            items.extend(s.steps)
+        else:
+            items.append(s)
     robot = station.robot
-    return {c.index: c.radius for c in blend_radii(list(steps), robot, robot.home)}
+    found = blend_columns(items, robot, robot.home)
+    return dict(zip(found.index.tolist(), found.radius.tolist(), strict=True))
 
 
 FILTERS: Mapping[str, Filter] = {
@@ -287,41 +349,38 @@ def stop_at_block_boundaries(
     as for :func:`cap_blend_radii`); stopping is olp's conservative choice. Idempotent."""
     if not compiled.program.has_flow:
         return compiled, []
-    by_index: dict[int, Any] = {s.index: s for s in compiled.steps}
+    steps = compiled.steps
     ends = [
-        i
+        (i, radius)
         for i in _motions_before_boundaries(compiled.program.instructions)
-        if i in by_index and not by_index[i].instruction.zone.is_fine
+        if 0 <= i < len(steps) and (radius := zone_radius(steps, i)) > 0.0
     ]
     if not ends:
         return compiled, []
-    stopped = set(ends)
-    steps = tuple(
-        dataclasses.replace(s, instruction=_without_blend(s.instruction))
-        if s.index in stopped
-        else s
-        for s in compiled.steps
-    )
-    program = with_step_instructions(compiled.program, [s.instruction for s in steps])
-    found = [_stop_warning(by_index[i]) for i in ends]
-    return dataclasses.replace(compiled, program=program, steps=steps), found
+    index = np.array([i for i, _ in ends], dtype=np.int64)
+    stopped = with_radii(compiled, index, np.zeros(index.size))
+    return stopped, [_stop_warning(i, radius, span_of(steps, i)) for i, radius in ends]
 
 
-def _without_blend(instruction: Any) -> Any:
-    return dataclasses.replace(instruction, zone=dataclasses.replace(instruction.zone, radius=0.0))
+def zone_radius(steps: Sequence[Step], index: int) -> float:
+    """The zone radius (m) of instruction ``index``, without making a toolpath row's step."""
+    item = steps.item_at(index) if isinstance(steps, StepBlocks) else steps[index]
+    if isinstance(item, PathBlock):
+        return float(item.node.zones[index - item.start])
+    motion: Any = item.instruction
+    return float(motion.zone.radius)
 
 
-def _stop_warning(step: Any) -> Diagnostic:
-    ins = step.instruction
+def _stop_warning(index: int, radius: float, span: SourceSpan) -> Diagnostic:
     return Diagnostic(
         "warning",
         "blend_stopped",
-        f"blend radius {ins.zone.radius * 1000:.1f} mm written as 0 (the robot stops here): the "
+        f"blend radius {radius * 1000:.1f} mm written as 0 (the robot stops here): the "
         "next motion is beyond a block boundary, known only at run time, so olp cannot keep "
         "the blends from overlapping (the controller would skip a move); the cycle time per "
         "path times it as a stop too",
-        ins.span,
-        step.index,
+        span,
+        index,
     )
 
 
@@ -380,6 +439,7 @@ class UrPost(Post):
     TRANSFORMS = (stop_at_block_boundaries, cap_blend_radii)
     ARC_ORIENTATIONS = frozenset({ArcOrientation.INTERPOLATE, ArcOrientation.PATH_CONSTANT})
     WRITES_FLOW = True
+    COLUMNS = True
 
     def __init__(self, manifest: Any) -> None:
         super().__init__(manifest)
@@ -393,6 +453,14 @@ class UrPost(Post):
     def reserved_names(self, compiled: CompiledProgram) -> Sequence[str]:
         """The program's variable names (:class:`~olp.posts.flow_text.Symbols`)."""
         return list(Symbols(compiled.program.instructions).spelling.values())
+
+    def step_columns(self, robot: Any, joints: Any) -> Mapping[str, Any]:
+        """None: URScript has no configuration bits (the pose and the planned joints say all)."""
+        return {}
+
+    def check_rows(self, block: PathBlock, compiled: CompiledProgram) -> list[Diagnostic]:
+        """Nothing: :meth:`check_instruction` (the base's) finds nothing in a linear move."""
+        return []
 
     def context_values(self, steps: Sequence[PostStep]) -> Mapping[str, Any]:
         """The flow writer of this file (``vendor.flow_kinds``: the steps it writes)."""
@@ -418,7 +486,7 @@ class UrPost(Post):
             )
             for decl, node in assigned_module_data(nodes)
         ]
-        motions = sum(1 for s in compiled.steps if s.joints is not None)
+        motions = sum(_emitted(item) for item in items_of(compiled.steps))
         if motions <= MAX_MOTIONS:
             return found
         return [
@@ -436,15 +504,23 @@ class UrPost(Post):
 def arc_blends(compiled: CompiledProgram) -> list[Diagnostic]:
     """Errors for ``movec`` blends the controller refuses (see the module docstring): an arc
     blended into another arc, and a blend sphere around either end of an arc that holds its via
-    point (radii after :func:`cap_blend_radii`)."""
-    motions = [s for s in compiled.steps if s.joints is not None and not s.skipped]
+    point (radii after :func:`cap_blend_radii`). A toolpath's rows are linear: only its last
+    row can be an arc's start, and only that row is made into a step."""
+    motions = [
+        item
+        for item in items_of(compiled.steps)
+        if _emitted(item) and (isinstance(item, PathBlock) or not item.skipped)
+    ]
     out: list[Diagnostic] = []
     for k, step in enumerate(motions):
+        if isinstance(step, PathBlock):
+            continue
         ins: Any = step.instruction
         if ins.kind != "circular":
             continue
-        before = motions[k - 1].instruction if k > 0 else None
-        if before is not None and before.kind == "circular" and not before.zone.is_fine:
+        before = _last_step(motions[k - 1]) if k > 0 else None
+        previous: Any = None if before is None else before.instruction
+        if previous is not None and previous.kind == "circular" and not previous.zone.is_fine:
             msg = (
                 "URScript cannot blend a movec into another movec (the controller refuses such "
                 "blends, CIRC_ARC_BLENDING_RADIUS): program a fine stop or a short linear move "
@@ -452,21 +528,32 @@ def arc_blends(compiled: CompiledProgram) -> list[Diagnostic]:
             )
             out.append(Diagnostic("error", "arc_blend", msg, ins.span, step.index))
             continue
-        out += _via_in_blend(motions, k, compiled.station.robot)
+        out += _via_in_blend(before, step, compiled.station.robot)
     return out
 
 
-def _via_in_blend(motions: list[Any], k: int, robot: Any) -> list[Diagnostic]:
-    """The error of a blend sphere at the start or end of arc ``k`` that holds its via point."""
-    step = motions[k]
+def _emitted(item: Step | PathBlock) -> int:
+    """How many motions ``item`` writes (a toolpath's rows, once resolved: all of them)."""
+    if isinstance(item, PathBlock):
+        return 0 if item.joints is None else len(item)
+    return int(item.joints is not None)
+
+
+def _last_step(item: Step | PathBlock) -> Step:
+    return item.step(len(item) - 1) if isinstance(item, PathBlock) else item
+
+
+def _via_in_blend(before: Step | None, step: Step, robot: Any) -> list[Diagnostic]:
+    """The error of a blend sphere at the start (``before``: the motion before the arc) or end
+    of arc ``step`` that holds its via point."""
     ins: Any = step.instruction
     if step.frame is None or step.frame.pose is None:
         return []
     via = (step.frame.pose @ ins.via.pose)[:3, 3]
-    ends = [(motions[k - 1], "start")] if k > 0 else []
+    ends = [(before, "start")] if before is not None else []
     ends.append((step, "end"))
     for end_step, where in ends:
-        radius = end_step.instruction.zone.radius
+        radius = end_step.instruction.zone.radius  # type: ignore[union-attr]
         if radius <= 0.0 or end_step.tool is None or end_step.tool.pose is None:
             continue
         tcp = (robot.flange_poses(end_step.joints) @ end_step.tool.pose)[:3, 3]
