@@ -241,7 +241,7 @@ class _Lowering(Motions, Events):
     def _decl(self, stmt: Decl) -> None:
         """A declaration in a routine: its values are tracked, and it is kept in the program
         (:class:`olp.ir.Declare`, one per name)."""
-        self.data.declare(stmt, self.variables.declare)
+        self.data.declare(stmt, self.variables.declare, local=True)
         for item in stmt.items:
             dims = tuple(to_expr(d, self._input_index) for d in item.dims or ())
             value = None if item.value is None else self._expr(item.value)
@@ -325,7 +325,8 @@ class _Lowering(Motions, Events):
                 found = self.sources.snippet(arg.span)
                 value = Unknown(
                     f"{param.name} is {found!r} in the call at {stmt.span.location}, which is not "
-                    f"constant ({value.reason})"
+                    f"constant ({value.reason})",
+                    missing=value.missing,
                 )
             bound[param.name.upper()] = value
         return bound
@@ -418,10 +419,13 @@ class _Lowering(Motions, Events):
         probe = self._child(loop=True, probe=True)
         unknown = Unknown(f"{stmt.counter} counts the FOR loop at line {stmt.span.line}")
         probe.variables.assign(stmt.counter.upper(), unknown)
+        self.ctx.probing_for += 1
         try:
             probe.lower_body(stmt.body)
         except ParseError:
             return False
+        finally:
+            self.ctx.probing_for -= 1
         return True
 
     def _unroll(self, stmt: ForLoop, counts: range) -> None:

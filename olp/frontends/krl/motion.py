@@ -35,6 +35,7 @@ from olp.frontends.krl.values import (
     AXES,
     CARTESIAN,
     EXTERNAL,
+    Unknown,
     is_axis_aggregate,
 )
 from olp.vendors.kuka import configuration_from_status_turn, frame_to_pose, pose_to_frame
@@ -56,6 +57,8 @@ _BASE_MOTION = {
 _SPLINE_MOTIONS = frozenset({"SPTP", "SLIN", "SCIRC", "SPTP_REL", "SLIN_REL", "SCIRC_REL"})
 _CP_APPROX = ("C_DIS", "C_VEL", "C_ORI")
 _ONE_CP_APPROX = frozenset((a,) for a in _CP_APPROX)
+_PTP_APPROX = frozenset({("C_PTP",), ("C_PTP", "C_DIS"), ("C_DIS",)})
+_LIN_APPROX = frozenset({("C_DIS",), ("C_DIS", "C_DIS")})
 _FAST_KEYWORDS = {"PTP": "PTP", "SPTP": "PTP", "LIN": "LIN", "SLIN": "LIN"}
 _AXIS_SET = frozenset(AXES)
 _CARTESIAN_SET = frozenset(CARTESIAN)
@@ -157,12 +160,8 @@ class Motions(InlineForms):
         if not approx:
             return ir.FINE
         cdis = self.state.cdis_mm
-        valid = ("C_PTP",) if base == "PTP" else ("C_DIS",)
-        if (
-            cdis is None
-            or approx not in (valid, (*valid, "C_DIS"))
-            or keyword not in ("PTP", "LIN")
-        ):
+        valid = _PTP_APPROX if base == "PTP" else _LIN_APPROX
+        if cdis is None or approx not in valid or keyword not in ("PTP", "LIN"):
             return None
         return ir.Zone(cdis / 1000.0)
 
@@ -187,11 +186,47 @@ class Motions(InlineForms):
                 f"{stmt.keyword} takes no #BASE/#TOOL (only the _REL motions do)",
                 stmt.frame_option.span,
             )
-        if stmt.with_clause:
+        runtime = None if self.ctx.probing_for else self._runtime_target(stmt)
+        if runtime is not None:
+            self._keep_runtime_motion(stmt, base, runtime)
+        elif stmt.with_clause:
             self._with_motion(stmt, base, relative)
         else:
             self._note_after_with(stmt)
             self._plain_motion(stmt, base, relative)
+
+    # ---- motions to targets known only at run time
+    def _runtime_target(self, stmt: MotionStmt) -> str | None:
+        """Why a target of ``stmt`` is known only when the program runs, else None.
+
+        A run-time target (or a component of an inline aggregate) is one olp cannot evaluate
+        although every name it depends on is declared: a position computed from a function's
+        result, an input, a parameter, a path-dependent value, a controller variable
+        (``joint = $AXIS_ACT_MEAS``). A name declared nowhere is left to the usual error, which
+        tells the user which data list or ``$config.dat`` is missing."""
+        for expr in stmt.targets:
+            parts = [m.value for m in expr.members] if isinstance(expr, Aggregate) else [expr]
+            for part in parts:
+                value = self._value(part)
+                if self._runtime(value):
+                    assert isinstance(value, Unknown)
+                    return value.reason
+        return None
+
+    def _keep_runtime_motion(self, stmt: MotionStmt, base: str, reason: str) -> None:
+        """Keep a motion to a run-time target as written (:class:`~olp.ir.Verbatim`, with a
+        warning): the KRL post writes it back, the controller computes the target; olp checks
+        nothing of it, and the next motion starts where olp does not know."""
+        if stmt.approx:
+            self._check_approx(stmt, base)
+        self._keep(stmt, f"its target is known only when the program runs ({reason})")
+        self._note(
+            stmt.span,
+            f"{stmt.keyword} to a target olp cannot know offline ({reason}): kept as written "
+            "and not checked (reach, limits, collisions, time)",
+        )
+        self.track.lose(f"the {stmt.keyword} at line {stmt.span.line} goes to a run-time target")
+        self._after_with = None
 
     def _plain_motion(self, stmt: MotionStmt, base: str, relative: bool) -> None:
         zone = self._zone(stmt, base)
@@ -306,8 +341,15 @@ class Motions(InlineForms):
         if spline and approx in (("C_SPL",), ("C_DIS",)):
             return
         if base == "PTP":
-            valid = approx[0] == "C_PTP" and (len(approx) == 1 or approx[1:] in _ONE_CP_APPROX)
-            rule = "PTP approximates with C_PTP, optionally followed by C_DIS, C_ORI or C_VEL"
+            # KSS 8.2 and later: the PTP inline form with CONT writes PTP XP1 C_DIS, the
+            # distance criterion ($APO.CDIS) instead of $APO.CPTP.
+            valid = approx == ("C_DIS",) or (
+                approx[0] == "C_PTP" and (len(approx) == 1 or approx[1:] in _ONE_CP_APPROX)
+            )
+            rule = (
+                "PTP approximates with C_DIS, or with C_PTP optionally followed by C_DIS, "
+                "C_ORI or C_VEL"
+            )
         else:
             # The inline forms of KSS 8 write the keyword twice: LIN XP1 C_DIS C_DIS.
             doubled = len(approx) == 2 and approx[0] == approx[1]
