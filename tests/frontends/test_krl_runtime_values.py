@@ -38,7 +38,7 @@ def kept(result: KrlResult) -> list[ir.Verbatim]:
 
 OFFSET = (
     "DEF lift( )\nDECL E6POS above\nPTP XHOME\nabove = $POS_ACT\n"
-    "above.Z = above.Z + 50\nLIN above\nPTP XHOME\nEND\n"
+    "above.Z = above.Z + 50\nPTP above\nPTP XHOME\nEND\n"
 )
 
 
@@ -47,23 +47,49 @@ def test_a_motion_to_an_offset_of_the_current_position_is_kept_with_a_warning(
 ) -> None:
     """``p = $POS_ACT`` then ``p.Z = p.Z + 50`` and ``LIN p``: the target is where the robot
     happens to stand, plus 50 mm. Kept as written, with a warning, and the motions after it are
-    still lowered."""
+    still lowered. The LIN before it has the same tool, base, speed and approximation: the
+    output writes them there, so the kept LIN runs with them."""
     result = parse(
         config,
         "DECL E6POS above",
         *FRAMES,
+        "$VEL.CP = 0.2",
         HOME,
+        "LIN {X 500,Y 0,Z 400,A 0,B 90,C 0}",
         "above = $POS_ACT",
         "above.Z = above.Z + 50",
         "LIN above",
         HOME,
     )
     (lin,) = kept(result)
-    assert (lin.span.line, lin.text) == (8, "LIN above")
+    assert (lin.span.line, lin.text) == (10, "LIN above")
     assert "known only when the program runs" in lin.reason and "$POS_ACT" in lin.reason
-    (note,) = [n for n in result.notes if n.span.line == 8]
+    (note,) = [n for n in result.notes if n.span.line == 10]
     assert note.message.startswith("LIN to a target olp cannot know offline")
-    assert [m.span.line for m in result.program.motions()] == [5, 9]
+    assert [m.span.line for m in result.program.motions()] == [6, 7, 11]
+
+
+@pytest.mark.parametrize(
+    ("before", "why"),
+    [
+        ((HOME,), "of another kind"),
+        (("LIN {X 500,Y 0,Z 400,A 0,B 90,C 0}", "$VEL.CP = 0.1"), "speed differs"),
+        (("LIN {X 500,Y 0,Z 400,A 0,B 90,C 0}", "$BASE = BASE_DATA[2]"), "frame differs"),
+        (("LIN {X 500,Y 0,Z 400,A 0,B 90,C 0}", "Foo()"), "call at line"),
+        (("IF $IN[1] THEN", "LIN {X 500,Y 0,Z 400,A 0,B 90,C 0}", "ENDIF"), "if at line"),
+    ],
+)
+def test_a_run_time_motion_whose_settings_the_output_does_not_hold_is_refused(
+    config: KrlData, before: tuple[str, ...], why: str
+) -> None:
+    """The posts write tool, base, speed and approximation only before the motions olp models,
+    and only where they change: a motion kept as written after other settings, a call or a
+    block would run with settings nobody checked. olp stops, naming the line and why."""
+    here = ["p = $POS_ACT", "p.Z = p.Z + 10"]
+    body = ["DECL E6POS p", *FRAMES, "$VEL.CP = 0.2", HOME, *before, *here, "LIN p"]
+    with pytest.raises(ParseError, match="cannot write the motion settings") as info:
+        parse(config, *body)
+    assert why in info.value.message and info.value.span.line == len(body) + 1
 
 
 @pytest.mark.parametrize(
@@ -81,12 +107,12 @@ def test_the_kuka_post_writes_a_run_time_motion_back_and_the_others_refuse_it(
     errors = [d for d in result.diagnostics if d.severity == "error"]
     if refused is None:
         assert result.ok and not errors
-        assert "LIN above" in result.files["lift.src"].splitlines()
+        assert "PTP above" in result.files["lift.src"].splitlines()
     else:
         assert not result.ok
         (verbatim,) = [d for d in errors if d.kind == "verbatim"]
         assert verbatim.span is not None and verbatim.span.line == 6
-        assert "'LIN above'" in verbatim.message
+        assert "'PTP above'" in verbatim.message
 
 
 def test_a_name_declared_nowhere_is_still_an_error(config: KrlData) -> None:
@@ -135,9 +161,8 @@ def test_bas_with_a_run_time_value_is_kept_and_the_next_motion_asks_for_settings
         parse(config, *body, *FRAMES, HOME)
 
 
-def test_bas_with_a_run_time_value_then_an_inline_form(config: KrlData) -> None:
-    """The next inline form (FDAT_ACT, PDAT_ACT, BAS with a constant) sets them all again."""
-    data = parse_dat(
+def _inline_data() -> KrlData:
+    return parse_dat(
         "\n".join(
             [
                 "DEFDAT t PUBLIC",
@@ -150,11 +175,28 @@ def test_bas_with_a_run_time_value_then_an_inline_form(config: KrlData) -> None:
         ),
         "t.dat",
     )
+
+
+INLINE_PTP = ["PDAT_ACT = PPDAT1", "FDAT_ACT = FP1", "BAS(#PTP_PARAMS, 100)", "PTP XP1"]
+
+
+def test_bas_with_a_run_time_value_then_an_inline_form_after_its_block(config: KrlData) -> None:
+    """The next inline form (FDAT_ACT, PDAT_ACT, BAS with a constant) sets them all again; after
+    the block that held the kept BAS, the output writes every setting of the next motion."""
+    body = ["DECL REAL v", "v = $OV_PRO", "IF $IN[1] THEN", "BAS(#PTP_PARAMS, v)", "ENDIF"]
+    text = "\n".join(["DEF t( )", *body, *INLINE_PTP, "END", ""])
+    result = parse_krl(text, "t.src", dat=_inline_data(), config=config)
+    assert [m.span.line for m in result.program.motions()] == [10]
+
+
+def test_a_motion_in_the_same_stretch_as_a_kept_bas_is_refused(config: KrlData) -> None:
+    """In the same straight stretch, the output would write only the settings that differ from
+    the motion before, while the kept BAS changed them on the controller: an error."""
     body = ["DECL REAL v", "v = $OV_PRO", "BAS(#PTP_PARAMS, v)"]
-    inline = ["PDAT_ACT = PPDAT1", "FDAT_ACT = FP1", "BAS(#PTP_PARAMS, 100)", "PTP XP1"]
-    text = "\n".join(["DEF t( )", *body, *inline, "END", ""])
-    result = parse_krl(text, "t.src", dat=data, config=config)
-    assert [m.span.line for m in result.program.motions()] == [8]
+    text = "\n".join(["DEF t( )", *body, *INLINE_PTP, "END", ""])
+    with pytest.raises(ParseError, match=r"follows BAS\(#PTP_PARAMS, v\) \(line 4\)") as info:
+        parse_krl(text, "t.src", dat=_inline_data(), config=config)
+    assert info.value.span.line == 8
 
 
 def test_an_array_declared_with_open_dimensions(config: KrlData) -> None:
@@ -186,10 +228,54 @@ def test_a_constant_for_loop_over_run_time_positions_is_kept_once_per_pass(
         "p = $POS_ACT",
         "FOR i = 1 TO 2",
         "  p.Z = p.Z + 10",
-        "  LIN p",
+        "  PTP p",
         "ENDFOR",
         HOME,
     )
-    lins = [n for n in result.program.instructions if isinstance(n, ir.Verbatim)]
-    assert [(n.span.line, n.text) for n in lins] == [(10, "LIN p"), (10, "LIN p")]
+    ptps = [n for n in result.program.instructions if isinstance(n, ir.Verbatim)]
+    assert [(n.span.line, n.text) for n in ptps] == [(10, "PTP p"), (10, "PTP p")]
     assert [m.span.line for m in result.program.motions()] == [6, 12]
+
+
+def test_an_unrolled_pass_sets_the_counter_a_kept_statement_reads(config: KrlData) -> None:
+    """A FOR loop olp unrolls (its targets depend on the counter) writes its passes one after
+    the other without the FOR: a statement kept as written that reads the counter (``r[i] =
+    $OV_PRO``, ``LIN xPath[i]`` to a run-time target) gets ``i = <pass>`` before it, so that
+    the controller reads the value the loop would have given it."""
+    data = parse_dat(
+        "\n".join(
+            [
+                "DEFDAT t PUBLIC",
+                "DECL E6AXIS corner[2]",
+                "corner[1]={A1 0,A2 -90,A3 90,A4 0,A5 30,A6 0}",
+                "corner[2]={A1 10,A2 -90,A3 90,A4 0,A5 30,A6 0}",
+                "ENDDAT",
+                "",
+            ]
+        ),
+        "t.dat",
+    )
+    body = ["DECL INT i", "DECL REAL r[2]", *FRAMES, "FOR i = 1 TO 2"]
+    loop = ["  r[i] = $OV_PRO", "  PTP corner[i]", "ENDFOR"]
+    text = "\n".join(["DEF t( )", *body, *loop, "END", ""])
+    result = parse_krl(text, "t.src", dat=data, config=config)
+    flat = [n for n in result.program.instructions if n.kind != "declare"]
+    assert [n.kind for n in flat] == ["assign", "assign", "joint"] * 2
+    counts = [n for n in flat if isinstance(n, ir.Assign) and n.span.line == 6]
+    assert [(n.target, n.value) for n in counts] == [
+        (ir.Name(name="i", span=n.span), ir.Constant(value=k, span=n.span))
+        for n, k in zip(counts, (1, 2), strict=True)
+    ]
+
+
+def test_an_unrolled_pass_that_does_not_read_the_counter_is_written_as_before(
+    config: KrlData,
+) -> None:
+    data = parse_dat(
+        "DEFDAT t PUBLIC\nDECL E6AXIS corner[2]\ncorner[1]={A1 0,A2 -90,A3 90,A4 0,A5 30,A6 0}\n"
+        "corner[2]={A1 10,A2 -90,A3 90,A4 0,A5 30,A6 0}\nENDDAT\n",
+        "t.dat",
+    )
+    text = "\n".join(["DEF t( )", "DECL INT i", *FRAMES, "FOR i = 1 TO 2", "  PTP corner[i]"])
+    result = parse_krl(text + "\nENDFOR\nEND\n", "t.src", dat=data, config=config)
+    assert [n.kind for n in result.program.instructions] == ["declare", "joint", "joint"]

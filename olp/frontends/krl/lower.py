@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
+import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -436,7 +437,10 @@ class _Lowering(Motions, Events):
             for count in counts:
                 self.ctx.spend(stmt)
                 self.variables.assign(counter, Num(float(count), True, stmt.span))
+                start = len(self.out)
                 self.lower_body(stmt.body)
+                if reads_name(self.out[start:], counter):  # kept as written: it reads the counter
+                    self.out.insert(start, _count_assign(stmt, count))
                 if self.exiting is not None or self.returned is not None:
                     self.exiting = None
                     break
@@ -820,3 +824,34 @@ def _functions_only(
         ignored=tuple(ignored),
         data_sources=tuple(d.filename for d in data),
     )
+
+
+def _count_assign(stmt: ForLoop, count: int) -> ir.Assign:
+    """``counter = count`` before an unrolled pass whose output reads the counter (a statement
+    kept as written, such as ``LIN xPath[i]`` to a run-time target or ``Foo(i)``), so that it
+    reads on the controller the value it would have in the loop."""
+    return ir.Assign(
+        target=ir.Name(name=stmt.counter, span=stmt.span),
+        value=ir.Constant(value=count, span=stmt.span),
+        span=stmt.span,
+    )
+
+
+def reads_name(nodes: Sequence[Any], name: str) -> bool:
+    """Whether lowered ``nodes`` read the variable ``name``: a :class:`ir.Name` in any of their
+    expressions, or the word in a statement kept as text (a verbatim line, a call's arguments)."""
+    word = re.compile(rf"(?<![\w$]){re.escape(name)}(?![\w$])", re.IGNORECASE)
+    pending: list[Any] = list(nodes)
+    while pending:
+        node = pending.pop()
+        if isinstance(node, ir.Name):
+            if node.name.upper() == name.upper():
+                return True
+        elif isinstance(node, str):
+            if word.search(node):
+                return True
+        elif isinstance(node, (tuple, list)):
+            pending.extend(node)
+        elif dataclasses.is_dataclass(node) and not isinstance(node, ir.SourceSpan):
+            pending.extend(getattr(node, f.name) for f in dataclasses.fields(node))
+    return False

@@ -6,7 +6,9 @@ Targets are inline aggregates or named points; Cartesian ones stay KRL values (m
 
 from __future__ import annotations
 
+import dataclasses
 import math
+import re
 from collections.abc import Callable
 from typing import Any
 
@@ -76,6 +78,7 @@ class Motions(InlineForms):
                 self.lower_statement(motion)  # type: ignore[attr-defined]
             return
         self.ctx.remaining -= len(rows)  # what lower_statement spends per line
+        self._after_kept_settings(rows.span)
         state = self.state
         zone = 0.0 if state.cdis_mm is None else state.cdis_mm / 1000.0
         fields = {"speed": state.speed, "tool": state.tool, "frame": state.frame}
@@ -217,8 +220,7 @@ class Motions(InlineForms):
         """Keep a motion to a run-time target as written (:class:`~olp.ir.Verbatim`, with a
         warning): the KRL post writes it back, the controller computes the target; olp checks
         nothing of it, and the next motion starts where olp does not know."""
-        if stmt.approx:
-            self._check_approx(stmt, base)
+        self._settings_written_before(stmt, base, reason)
         self._keep(stmt, f"its target is known only when the program runs ({reason})")
         self._note(
             stmt.span,
@@ -227,6 +229,77 @@ class Motions(InlineForms):
         )
         self.track.lose(f"the {stmt.keyword} at line {stmt.span.line} goes to a run-time target")
         self._after_with = None
+
+    def _after_kept_settings(self, span: ir.SourceSpan) -> None:
+        """A motion olp models after a BAS kept as written (one given run-time values) in the
+        same straight stretch: the BAS changed the controller's settings behind the output's
+        back, and the posts write a setting only where it differs from the previous motion's,
+        so this motion could run with the BAS's values. An error naming the BAS."""
+        for node in reversed(self.out):
+            if isinstance(node, (ir.Label, *ir.BLOCK_TYPES)):
+                return
+            if isinstance(node, ir.Verbatim) and node.reason.startswith("BAS #"):
+                raise self._error(
+                    f"this motion follows {node.text} (line {node.span.line}), kept as written "
+                    "because it sets motion settings from run-time values: olp cannot make the "
+                    "output write the settings this motion runs with after it",
+                    span,
+                    hint="olp keeps such a BAS where no motion follows it before the end of its "
+                    "block or a label (a routine that only sets the speeds)",
+                )
+
+    def _settings_written_before(self, stmt: MotionStmt, base: str, reason: str) -> None:
+        """A motion kept as written runs with the tool, base, speed and approximation the
+        controller holds; the posts write those only before the motions olp models, and only
+        where they change. So it is kept only right after a modelled motion of its kind (PTP,
+        or LIN/CIRC) with the same settings, in the same straight stretch of the program: the
+        output has written them there and nothing in between changes them."""
+        zone = self._zone(stmt, base)
+        fields = self._fields(stmt, zone)
+        joint = base == "PTP"
+        why = self._previous_settings(fields, joint)
+        if why is not None:
+            raise self._error(
+                f"{stmt.keyword} to a target olp cannot know offline ({reason}): olp would keep "
+                f"it as written, but cannot write the motion settings it runs with ({why})",
+                stmt.span,
+                hint=f"olp keeps such a motion only right after a {'PTP' if joint else 'LIN'} "
+                "with the same tool, base, speed and approximation, in the same block; or give "
+                "it a target olp can compute (a taught point, a constant offset)",
+            )
+
+    def _previous_settings(self, fields: dict[str, Any], joint: bool) -> str | None:
+        """Why the settings in ``fields`` may not be on the controller here, else None."""
+        for node in reversed(self.out):
+            if isinstance(node, ir.Verbatim) and _is_motion_text(node.text):
+                continue  # a motion kept before, already checked: it changes no setting
+            if isinstance(node, Pending):
+                made, got = node.make, node.fields
+            elif isinstance(node, PendingRows):  # plain LINs: the last row is the one before
+                made, got = ir.LinearMove, dict(node.fields)
+                got["speed"] = dataclasses.replace(got["speed"], linear=float(node.speeds[-1]))
+                got["zone"] = ir.Zone(radius=float(node.zones[-1]))
+            elif isinstance(node, ir.JointMove | ir.LinearMove | ir.CircularMove):
+                made = type(node)
+                got = {k: getattr(node, k) for k in ("speed", "zone", "tool", "frame")}
+            elif isinstance(node, ir.Comment | ir.Wait | ir.SetOutput | ir.WaitInput):
+                continue
+            elif isinstance(node, ir.Assign | ir.Declare | ir.WaitUntil):
+                target = getattr(node, "target", None)
+                if isinstance(target, ir.Name | ir.Index | ir.Member) and _names_system(target):
+                    return f"line {node.span.line} sets a system variable olp writes as written"
+                continue
+            else:
+                kind = getattr(node, "kind", type(node).__name__)
+                line = getattr(getattr(node, "span", None), "line", "?")
+                return f"no motion of its kind before it since the {kind} at line {line}"
+            if (made is ir.JointMove) != joint:
+                return "the motion before it is of another kind"
+            for key in ("tool", "frame", "speed", "zone"):
+                if not _same(got[key], fields[key]):
+                    return f"its {key} differs from the motion's before it"
+            return None
+        return "no motion before it in its block"
 
     def _plain_motion(self, stmt: MotionStmt, base: str, relative: bool) -> None:
         zone = self._zone(stmt, base)
@@ -292,6 +365,7 @@ class Motions(InlineForms):
         via: Cartesian | None,
         fields: dict[str, Any],
     ) -> None:
+        self._after_kept_settings(fields["span"])
         if isinstance(target, ir.JointTarget):
             self.out.append(make(target=target, **fields))
         else:
@@ -541,3 +615,29 @@ def _offset(start: tuple[float, ...], delta: tuple[float, ...], option: str) -> 
         pose[:3, :3] = delta_pose[:3, :3] @ start_pose[:3, :3]
         pose[:3, 3] = start_pose[:3, 3] + delta_pose[:3, 3]
     return tuple(float(v) for v in pose_to_frame(pose))
+
+
+_MOTION_TEXT = re.compile(r"\s*(S?PTP|S?LIN|S?CIRC)(_REL)?\b", re.IGNORECASE)
+
+
+def _is_motion_text(text: str) -> bool:
+    return _MOTION_TEXT.match(text) is not None
+
+
+def _names_system(expr: Any) -> bool:
+    """Whether an assignment target is (part of) a system variable (``$APO.CPTP``)."""
+    while isinstance(expr, ir.Index | ir.Member):
+        expr = expr.base
+    return isinstance(expr, ir.Name) and expr.name.startswith("$")
+
+
+def _same(a: Any, b: Any) -> bool:
+    """Equal motion settings (tools and frames compared by name, number and pose)."""
+    if isinstance(a, ir.Tool | ir.Frame) and isinstance(b, ir.Tool | ir.Frame):
+        return (
+            type(a) is type(b)
+            and a.name == b.name
+            and a.number == b.number
+            and np.array_equal(np.asarray(a.pose), np.asarray(b.pose))
+        )
+    return bool(a == b)
