@@ -46,8 +46,19 @@ What is lowered
 * **Motions to run-time targets** (a position computed from a function's result, an input, a
   routine parameter or a path-dependent value, all of its names declared) are kept as written
   (:class:`olp.ir.Verbatim`) with a warning: the controller computes the target, olp checks
-  nothing of that motion, and the next motion starts where olp does not know. A name declared
+  nothing of that motion, and the next motion starts where olp does not know. The posts write
+  tool, base, speed and approximation only before the motions olp models, and only where they
+  change: so such a motion is kept only right after a modelled motion of its kind (PTP, or
+  LIN/CIRC) with the same settings, in the same straight stretch (no block, label, call,
+  statement kept as written or system-variable assignment between); elsewhere it is an error
+  saying why. A name declared
   nowhere stays an error naming the data list that would declare it.
+* **BAS with run-time values** (``BAS(#PTP_PARAMS, v)``, or ``PDAT_ACT`` given a parameter) is
+  kept as written; the settings it sets are ambiguous until set again, and a modelled motion
+  after it in the same straight stretch is an error (the output would not write the settings
+  that BAS changed behind its back). A settings routine without motions builds.
+* **Unrolled FOR loops** write ``counter = n`` before a pass whose output reads the counter
+  (a statement kept as written such as ``LIN xPath[i]``, ``r[i] = $OV_PRO``, ``Foo(i)``).
 * **Speeds.** ``$VEL.CP`` (m/s) -> ``Speed.linear``; ``$VEL_AXIS[i]``/``$ACC_AXIS[i]`` (%) ->
   ``Speed.joint``/``joint_acceleration`` as the **minimum** over the axes set so far (one
   fraction cannot hold per-axis values; the slowest axis bounds a synchronised PTP).
