@@ -287,7 +287,7 @@ def test_approximation_uses_apo_cdis() -> None:
 
 @pytest.mark.parametrize(
     "motion",
-    [f"LIN {FULL} C_PTP", f"LIN {FULL} C_DIS C_VEL", "PTP {A1 0,A2 0,A3 0,A4 0,A5 0,A6 0} C_DIS"],
+    [f"LIN {FULL} C_PTP", f"LIN {FULL} C_DIS C_VEL", "PTP {A1 0,A2 0,A3 0,A4 0,A5 0,A6 0} C_VEL"],
 )
 def test_invalid_approximation(motion: str) -> None:
     assert "invalid approximation" in parse_error(motion).message

@@ -11,6 +11,7 @@ import olp
 from olp import ir
 from olp.frontends.bundled import KrlOptions
 from olp.frontends.krl import load_krl
+from olp.ir_flow import leaves_and_blocks
 
 REPO = Path(__file__).resolve().parents[2]
 STATION = REPO / "stations" / "kr6_milling_cell.yaml"
@@ -178,18 +179,34 @@ def test_a_motion_to_a_variable_given_pos_act_is_kept_as_no_motion(tmp_path: Pat
     assert [n.span.line for n in program.motions()] == [5]
 
 
+def test_a_held_pos_act_is_stale_after_a_motion(tmp_path: Path) -> None:
+    """After a motion, pAct is a position only the run knows: the SPTP to it is kept as written
+    with a warning (not checked), not taken as "no motion". The PTP before it has written the
+    settings it runs with (its WITH sets the rest)."""
+    path = tmp_path / "here.src"
+    path.write_text(HERE_PROGRAM.format(between="PTP XHOME\n"))
+    result = load_krl(path, CORPUS / "System" / "$config.dat")
+    (kept,) = [n for n in leaves_and_blocks(result.program.instructions) if n.kind == "verbatim"]
+    assert kept.span.line == 5 and kept.text.startswith("SPTP pAct")
+    assert "known only when the program runs" in kept.reason and "pAct" in kept.reason
+    (note,) = [n for n in result.notes if n.span.line == 5]
+    assert "cannot know offline" in note.message
+
+
 @pytest.mark.parametrize(
     "between",
     [
-        "PTP XHOME\n",  # the robot moved: pAct is where it was, olp does not know where
         "IF $IN[3] THEN\nPTP XHOME\nENDIF\n",
         "GO_SOMEWHERE()\n",  # another module's routine may move it
     ],
 )
 def test_a_held_pos_act_is_stale_after_anything_that_may_move(tmp_path: Path, between: str) -> None:
+    """After a block or a call that may move the robot, pAct is known only when the program
+    runs, and olp cannot tell which tool, base and speed the controller holds there: an
+    error, not a motion written with settings nobody checked."""
     path = tmp_path / "here.src"
     path.write_text(HERE_PROGRAM.format(between=between))
-    with pytest.raises(olp.errors.ParseError, match="pAct"):
+    with pytest.raises(olp.errors.ParseError, match=r"pAct.*cannot write the motion settings"):
         load_krl(path, CORPUS / "System" / "$config.dat")
 
 

@@ -40,8 +40,25 @@ What is lowered
 * **Approximation.** None: exact stop (:data:`olp.ir.FINE`). ``C_DIS``/``C_SPL`` use the current
   ``$APO.CDIS`` (mm) as the zone radius; ``C_PTP`` (KRL: ``$APO.CPTP`` in %) and ``C_VEL``/
   ``C_ORI`` use the same distance (``C_VEL``/``C_ORI`` add a note). The inline forms' doubled
-  ``C_DIS C_DIS`` reads as ``C_DIS``. Before any ``$APO.CDIS`` a motion stops exactly, with a
-  note.
+  ``C_DIS C_DIS`` reads as ``C_DIS``; ``PTP XP1 C_DIS`` (what the PTP inline form writes with
+  CONT since KSS 8.2: the distance criterion) uses ``$APO.CDIS`` too. Before any ``$APO.CDIS``
+  a motion stops exactly, with a note.
+* **Motions to run-time targets** (a position computed from a function's result, an input, a
+  routine parameter or a path-dependent value, all of its names declared) are kept as written
+  (:class:`olp.ir.Verbatim`) with a warning: the controller computes the target, olp checks
+  nothing of that motion, and the next motion starts where olp does not know. The posts write
+  tool, base, speed and approximation only before the motions olp models, and only where they
+  change: so such a motion is kept only right after a modelled motion of its kind (PTP, or
+  LIN/CIRC) with the same settings, in the same straight stretch (no block, label, call,
+  statement kept as written or system-variable assignment between); elsewhere it is an error
+  saying why. A name declared
+  nowhere stays an error naming the data list that would declare it.
+* **BAS with run-time values** (``BAS(#PTP_PARAMS, v)``, or ``PDAT_ACT`` given a parameter) is
+  kept as written; the settings it sets are ambiguous until set again, and a modelled motion
+  after it in the same straight stretch is an error (the output would not write the settings
+  that BAS changed behind its back). A settings routine without motions builds.
+* **Unrolled FOR loops** write ``counter = n`` before a pass whose output reads the counter
+  (a statement kept as written such as ``LIN xPath[i]``, ``r[i] = $OV_PRO``, ``Foo(i)``).
 * **Speeds.** ``$VEL.CP`` (m/s) -> ``Speed.linear``; ``$VEL_AXIS[i]``/``$ACC_AXIS[i]`` (%) ->
   ``Speed.joint``/``joint_acceleration`` as the **minimum** over the axes set so far (one
   fraction cannot hold per-axis values; the slowest axis bounds a synchronised PTP).
@@ -86,7 +103,7 @@ What is lowered
 * **Motions to where the robot is** (``PTP $POS_ACT``, ``PTP $AXIS_ACT``: the block
   coincidence run) are kept as written (:class:`olp.ir.Verbatim`): there is nothing to check.
   A motion to a value derived from them at run time (``lNow.Z = lNow.Z + 100``, ``LIN lNow``)
-  is an error that says so.
+  is a motion to a run-time target (above).
 * **Data.** Declarations in the program are :class:`~olp.ir.Declare`, assignments of the
   program's variables :class:`~olp.ir.Assign` (their constant values are also used, as before);
   what the inline forms assign for BAS (``PDAT_ACT``, ``LDAT_ACT``, ``FDAT_ACT``) is absorbed

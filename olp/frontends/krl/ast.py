@@ -306,7 +306,7 @@ class WaitFor:
 @dataclass(frozen=True, slots=True)
 class DeclItem:
     name: str
-    dims: tuple[Expr, ...] | None
+    dims: tuple[Expr | None, ...] | None  # a position left out (xPath[,]) is None
     value: Expr | None
     span: ir.SourceSpan
 

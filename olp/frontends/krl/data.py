@@ -111,8 +111,11 @@ class DataOps:
         self.evaluator = evaluator
         self.sources = sources
 
-    def declare(self, decl: Decl, into: Callable[[str, Value], None]) -> str | None:
-        """Each item gets its value (or :class:`Unknown` when it has none)."""
+    def declare(
+        self, decl: Decl, into: Callable[[str, Value], None], local: bool = False
+    ) -> str | None:
+        """Each item gets its value (or :class:`Unknown` when it has none: ``missing`` for a
+        ``local`` variable of a routine, which nothing but the routine itself can set)."""
         missing = []
         for item in decl.items:
             name = item.name.upper()
@@ -123,7 +126,11 @@ class DataOps:
                 if not self.variables.is_param(name):
                     missing.append(item.name)
                 where = f"{item.span.location}"
-                into(name, Unknown(f"{item.name} is declared at {where} without a value"))
+                unset = local and not self.variables.is_param(name)
+                into(
+                    name,
+                    Unknown(f"{item.name} is declared at {where} without a value", missing=unset),
+                )
                 continue
             value = self.evaluator.evaluate(item.value)
             into(name, value if isinstance(value, Unknown) else with_type(value, decl.type_name))
@@ -167,7 +174,7 @@ class DataOps:
         """``name`` is unknown from here on; the reason says where and why (with its hint)."""
         value = self.sources.snippet(stmt.value.span)
         message = f"{stmt.target.name} was assigned {value!r} at {stmt.span.location}"
-        self.variables.assign(name, Unknown(f"{message}, and {why.reason}", why.hint))
+        self.variables.assign(name, Unknown(f"{message}, and {why.reason}", why.hint, why.missing))
 
     def signal(self, stmt: SignalDecl, into: Callable[[str, Value], None]) -> str | None:
         """``SIGNAL name $OUT[n]``: the name stands for that one bit from here on."""
@@ -226,7 +233,7 @@ def _read_block(block: DatBlock, source: Source) -> KrlData:
     base = os.path.basename(source.filename)
 
     def missing(name: str) -> Unknown:
-        return Unknown(f"{name} is not declared in {base} before this line")
+        return Unknown(f"{name} is not declared in {base} before this line", missing=True)
 
     values: dict[str, Value] = {}
     variables = Variables(values, missing)

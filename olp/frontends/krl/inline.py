@@ -27,6 +27,35 @@ from olp.frontends.krl.values import (
     Unknown,
 )
 
+_BAS_READS: dict[str, tuple[str, ...]] = {
+    "VEL_CP": ("value",),
+    "VEL_PTP": ("value",),
+    "ACC_PTP": ("value",),
+    "TOOL": ("value",),
+    "BASE": ("value",),
+    "FRAMES": ("FDAT_ACT",),
+    "PTP_DAT": ("PDAT_ACT",),
+    "CP_DAT": ("LDAT_ACT",),
+    "PTP_PARAMS": ("value", "FDAT_ACT", "PDAT_ACT"),
+    "CP_PARAMS": ("value", "FDAT_ACT", "LDAT_ACT"),
+}
+"""What each BAS command reads: its value argument and the inline forms' data records."""
+
+_BAS_SETS: dict[str, tuple[str, ...]] = {
+    "VEL_CP": ("speed",),
+    "VEL_PTP": ("vel_axis", "speed"),
+    "ACC_PTP": ("acc_axis", "speed"),
+    "TOOL": ("tool",),
+    "BASE": ("frame",),
+    "FRAMES": ("tool", "frame"),
+    "PTP_DAT": ("vel_axis", "acc_axis", "speed", "cdis_mm"),
+    "CP_DAT": ("speed", "cdis_mm"),
+    "PTP_PARAMS": ("vel_axis", "acc_axis", "speed", "cdis_mm", "tool", "frame"),
+    "CP_PARAMS": ("speed", "cdis_mm", "tool", "frame"),
+}
+"""The motion settings (fields of :class:`~olp.frontends.krl.state.State`) each BAS command
+sets, as :meth:`InlineForms._bas_handlers` lowers them."""
+
 
 class InlineForms(Core):
     """BAS commands and WITH assignments of the inline forms."""
@@ -44,7 +73,40 @@ class InlineForms(Core):
                 hint="olp lowers BAS #INITMOV, #VEL_CP, #VEL_PTP, #ACC_PTP, #ACC_CP, #TOOL, "
                 "#BASE, #FRAMES, #PTP_DAT, #CP_DAT, #PTP_PARAMS and #CP_PARAMS",
             )
-        handler(stmt)
+        reason = self._bas_runtime(stmt, name)
+        if reason is None:
+            handler(stmt)
+        else:
+            self._bas_at_run_time(stmt, name, reason)
+
+    def _bas_runtime(self, stmt: CallStmt, command: str) -> str | None:
+        """Why BAS ``command`` reads a value known only when the program runs (its argument,
+        or ``PDAT_ACT``/``LDAT_ACT``/``FDAT_ACT`` given a parameter or a path-dependent value,
+        as in a routine ``SetVel(eVelocity)`` that picks the PDAT by a SWITCH), else None."""
+        reads = _BAS_READS.get(command, ())
+        for read in reads:
+            if read == "value":
+                arg = stmt.args[1] if len(stmt.args) == 2 else None
+                value = None if arg is None else self._value(arg)
+            else:
+                value = self.variables.lookup(read)
+            if value is not None and self._runtime(value):
+                assert isinstance(value, Unknown)
+                return value.reason
+        return None
+
+    def _bas_at_run_time(self, stmt: CallStmt, command: str, reason: str) -> None:
+        """Keep a BAS command with run-time values as written: the KRL post writes it back;
+        the motion settings it sets are unknown from here on, so a motion that relies on them
+        is an error, and a module without one (a settings routine) builds."""
+        self._keep(stmt, f"BAS #{command} with a value known only at run time ({reason})")
+        ambiguous: dict[str, str] | None = getattr(self, "ambiguous", None)
+        why = f"BAS(#{command}) at line {stmt.span.line} sets them from run-time values"
+        for field_name in _BAS_SETS[command]:
+            if ambiguous is not None:
+                ambiguous[field_name] = why
+        if {"tool", "frame"} & set(_BAS_SETS[command]):
+            self.track.lose_cartesian(f"$TOOL/$BASE were set at run time at line {stmt.span.line}")
 
     def _bas_handlers(self) -> dict[str, Callable[[CallStmt], None]]:
         return {

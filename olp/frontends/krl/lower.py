@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
+import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -242,7 +243,7 @@ class _Lowering(Motions, Events):
     def _decl(self, stmt: Decl) -> None:
         """A declaration in a routine: its values are tracked, and it is kept in the program
         (:class:`olp.ir.Declare`, one per name)."""
-        self.data.declare(stmt, self.variables.declare)
+        self.data.declare(stmt, self.variables.declare, local=True)
         for item in stmt.items:
             dims = tuple(to_expr(d, self._input_index) for d in item.dims or ())
             value = None if item.value is None else self._expr(item.value)
@@ -326,7 +327,8 @@ class _Lowering(Motions, Events):
                 found = self.sources.snippet(arg.span)
                 value = Unknown(
                     f"{param.name} is {found!r} in the call at {stmt.span.location}, which is not "
-                    f"constant ({value.reason})"
+                    f"constant ({value.reason})",
+                    missing=value.missing,
                 )
             bound[param.name.upper()] = value
         return bound
@@ -419,10 +421,13 @@ class _Lowering(Motions, Events):
         probe = self._child(loop=True, probe=True)
         unknown = Unknown(f"{stmt.counter} counts the FOR loop at line {stmt.span.line}")
         probe.variables.assign(stmt.counter.upper(), unknown)
+        self.ctx.probing_for += 1
         try:
             probe.lower_body(stmt.body)
         except ParseError:
             return False
+        finally:
+            self.ctx.probing_for -= 1
         return True
 
     def _unroll(self, stmt: ForLoop, counts: range) -> None:
@@ -433,7 +438,10 @@ class _Lowering(Motions, Events):
             for count in counts:
                 self.ctx.spend(stmt)
                 self.variables.assign(counter, Num(float(count), True, stmt.span))
+                start = len(self.out)
                 self.lower_body(stmt.body)
+                if reads_name(self.out[start:], counter):  # kept as written: it reads the counter
+                    self.out.insert(start, _count_assign(stmt, count))
                 if self.exiting is not None or self.returned is not None:
                     self.exiting = None
                     break
@@ -818,3 +826,34 @@ def _functions_only(
         ignored=tuple(ignored),
         data_sources=tuple(d.filename for d in data),
     )
+
+
+def _count_assign(stmt: ForLoop, count: int) -> ir.Assign:
+    """``counter = count`` before an unrolled pass whose output reads the counter (a statement
+    kept as written, such as ``LIN xPath[i]`` to a run-time target or ``Foo(i)``), so that it
+    reads on the controller the value it would have in the loop."""
+    return ir.Assign(
+        target=ir.Name(name=stmt.counter, span=stmt.span),
+        value=ir.Constant(value=count, span=stmt.span),
+        span=stmt.span,
+    )
+
+
+def reads_name(nodes: Sequence[Any], name: str) -> bool:
+    """Whether lowered ``nodes`` read the variable ``name``: a :class:`ir.Name` in any of their
+    expressions, or the word in a statement kept as text (a verbatim line, a call's arguments)."""
+    word = re.compile(rf"(?<![\w$]){re.escape(name)}(?![\w$])", re.IGNORECASE)
+    pending: list[Any] = list(nodes)
+    while pending:
+        node = pending.pop()
+        if isinstance(node, ir.Name):
+            if node.name.upper() == name.upper():
+                return True
+        elif isinstance(node, str):
+            if word.search(node):
+                return True
+        elif isinstance(node, (tuple, list)):
+            pending.extend(node)
+        elif dataclasses.is_dataclass(node) and not isinstance(node, ir.SourceSpan):
+            pending.extend(getattr(node, f.name) for f in dataclasses.fields(node))
+    return False

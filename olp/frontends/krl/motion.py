@@ -6,7 +6,9 @@ Targets are inline aggregates or named points; Cartesian ones stay KRL values (m
 
 from __future__ import annotations
 
+import dataclasses
 import math
+import re
 from collections.abc import Callable
 from typing import Any
 
@@ -35,6 +37,7 @@ from olp.frontends.krl.values import (
     AXES,
     CARTESIAN,
     EXTERNAL,
+    Unknown,
     is_axis_aggregate,
 )
 from olp.vendors.kuka import configuration_from_status_turn, frame_to_pose, pose_to_frame
@@ -56,6 +59,8 @@ _BASE_MOTION = {
 _SPLINE_MOTIONS = frozenset({"SPTP", "SLIN", "SCIRC", "SPTP_REL", "SLIN_REL", "SCIRC_REL"})
 _CP_APPROX = ("C_DIS", "C_VEL", "C_ORI")
 _ONE_CP_APPROX = frozenset((a,) for a in _CP_APPROX)
+_PTP_APPROX = frozenset({("C_PTP",), ("C_PTP", "C_DIS"), ("C_DIS",)})
+_LIN_APPROX = frozenset({("C_DIS",), ("C_DIS", "C_DIS")})
 _FAST_KEYWORDS = {"PTP": "PTP", "SPTP": "PTP", "LIN": "LIN", "SLIN": "LIN"}
 _AXIS_SET = frozenset(AXES)
 _CARTESIAN_SET = frozenset(CARTESIAN)
@@ -73,6 +78,7 @@ class Motions(InlineForms):
                 self.lower_statement(motion)  # type: ignore[attr-defined]
             return
         self.ctx.remaining -= len(rows)  # what lower_statement spends per line
+        self._after_kept_settings(rows.span)
         state = self.state
         zone = 0.0 if state.cdis_mm is None else state.cdis_mm / 1000.0
         fields = {"speed": state.speed, "tool": state.tool, "frame": state.frame}
@@ -157,12 +163,8 @@ class Motions(InlineForms):
         if not approx:
             return ir.FINE
         cdis = self.state.cdis_mm
-        valid = ("C_PTP",) if base == "PTP" else ("C_DIS",)
-        if (
-            cdis is None
-            or approx not in (valid, (*valid, "C_DIS"))
-            or keyword not in ("PTP", "LIN")
-        ):
+        valid = _PTP_APPROX if base == "PTP" else _LIN_APPROX
+        if cdis is None or approx not in valid or keyword not in ("PTP", "LIN"):
             return None
         return ir.Zone(cdis / 1000.0)
 
@@ -187,11 +189,117 @@ class Motions(InlineForms):
                 f"{stmt.keyword} takes no #BASE/#TOOL (only the _REL motions do)",
                 stmt.frame_option.span,
             )
-        if stmt.with_clause:
+        runtime = None if self.ctx.probing_for else self._runtime_target(stmt)
+        if runtime is not None:
+            self._keep_runtime_motion(stmt, base, runtime)
+        elif stmt.with_clause:
             self._with_motion(stmt, base, relative)
         else:
             self._note_after_with(stmt)
             self._plain_motion(stmt, base, relative)
+
+    # ---- motions to targets known only at run time
+    def _runtime_target(self, stmt: MotionStmt) -> str | None:
+        """Why a target of ``stmt`` is known only when the program runs, else None.
+
+        A run-time target (or a component of an inline aggregate) is one olp cannot evaluate
+        although every name it depends on is declared: a position computed from a function's
+        result, an input, a parameter, a path-dependent value, a controller variable
+        (``joint = $AXIS_ACT_MEAS``). A name declared nowhere is left to the usual error, which
+        tells the user which data list or ``$config.dat`` is missing."""
+        for expr in stmt.targets:
+            parts = [m.value for m in expr.members] if isinstance(expr, Aggregate) else [expr]
+            for part in parts:
+                value = self._value(part)
+                if self._runtime(value):
+                    assert isinstance(value, Unknown)
+                    return value.reason
+        return None
+
+    def _keep_runtime_motion(self, stmt: MotionStmt, base: str, reason: str) -> None:
+        """Keep a motion to a run-time target as written (:class:`~olp.ir.Verbatim`, with a
+        warning): the KRL post writes it back, the controller computes the target; olp checks
+        nothing of it, and the next motion starts where olp does not know."""
+        self._settings_written_before(stmt, base, reason)
+        self._keep(stmt, f"its target is known only when the program runs ({reason})")
+        self._note(
+            stmt.span,
+            f"{stmt.keyword} to a target olp cannot know offline ({reason}): kept as written "
+            "and not checked (reach, limits, collisions, time)",
+        )
+        self.track.lose(f"the {stmt.keyword} at line {stmt.span.line} goes to a run-time target")
+        self._after_with = None
+
+    def _after_kept_settings(self, span: ir.SourceSpan) -> None:
+        """A motion olp models after a BAS kept as written (one given run-time values) in the
+        same straight stretch: the BAS changed the controller's settings behind the output's
+        back, and the posts write a setting only where it differs from the previous motion's,
+        so this motion could run with the BAS's values. An error naming the BAS."""
+        for node in reversed(self.out):
+            if isinstance(node, (ir.Label, *ir.BLOCK_TYPES)):
+                return
+            if isinstance(node, ir.Verbatim) and node.reason.startswith("BAS #"):
+                raise self._error(
+                    f"this motion follows {node.text} (line {node.span.line}), kept as written "
+                    "because it sets motion settings from run-time values: olp cannot make the "
+                    "output write the settings this motion runs with after it",
+                    span,
+                    hint="olp keeps such a BAS where no motion follows it before the end of its "
+                    "block or a label (a routine that only sets the speeds)",
+                )
+
+    def _settings_written_before(self, stmt: MotionStmt, base: str, reason: str) -> None:
+        """A motion kept as written runs with the tool, base, speed and approximation the
+        controller holds; the posts write those only before the motions olp models, and only
+        where they change. So it is kept only right after a modelled motion of its kind (PTP,
+        or LIN/CIRC) with the same settings, in the same straight stretch of the program: the
+        output has written them there and nothing in between changes them."""
+        zone = self._zone(stmt, base)
+        fields = self._fields(stmt, zone)
+        joint = base == "PTP"
+        why = self._previous_settings(fields, joint)
+        if why is not None:
+            raise self._error(
+                f"{stmt.keyword} to a target olp cannot know offline ({reason}): olp would keep "
+                f"it as written, but cannot write the motion settings it runs with ({why})",
+                stmt.span,
+                hint=f"olp keeps such a motion only right after a {'PTP' if joint else 'LIN'} "
+                "with the same tool, base, speed and approximation, in the same block; or give "
+                "it a target olp can compute (a taught point, a constant offset)",
+            )
+
+    def _previous_settings(self, fields: dict[str, Any], joint: bool) -> str | None:
+        """Why the settings in ``fields`` may not be on the controller here, else None."""
+        for node in reversed(self.out):
+            if isinstance(node, ir.Verbatim) and _is_motion_text(node.text):
+                continue  # a motion kept before, already checked: it changes no setting
+            if isinstance(node, Pending):
+                made, got = node.make, node.fields
+            elif isinstance(node, PendingRows):  # plain LINs: the last row is the one before
+                made, got = ir.LinearMove, dict(node.fields)
+                got["speed"] = dataclasses.replace(got["speed"], linear=float(node.speeds[-1]))
+                got["zone"] = ir.Zone(radius=float(node.zones[-1]))
+            elif isinstance(node, ir.JointMove | ir.LinearMove | ir.CircularMove):
+                made = type(node)
+                got = {k: getattr(node, k) for k in ("speed", "zone", "tool", "frame")}
+            elif isinstance(node, ir.Comment | ir.Wait | ir.SetOutput | ir.WaitInput):
+                continue
+            elif isinstance(node, ir.Assign | ir.Declare | ir.WaitUntil):
+                target = getattr(node, "target", None)
+                if isinstance(target, ir.Name | ir.Index | ir.Member) and _names_system(target):
+                    return f"line {node.span.line} sets a system variable olp writes as written"
+                continue
+            else:
+                kind = getattr(node, "kind", type(node).__name__)
+                line = getattr(getattr(node, "span", None), "line", "?")
+                return f"no motion of its kind before it since the {kind} at line {line}"
+            if (made is ir.JointMove) != joint:
+                return "the motion before it is of another kind"
+            for key in ("tool", "frame", "speed", "zone"):
+                if not _same(got[key], fields[key]):
+                    return f"its {key} differs from the motion's before it"
+            return None
+        return "no motion before it in its block"
 
     def _plain_motion(self, stmt: MotionStmt, base: str, relative: bool) -> None:
         zone = self._zone(stmt, base)
@@ -257,6 +365,7 @@ class Motions(InlineForms):
         via: Cartesian | None,
         fields: dict[str, Any],
     ) -> None:
+        self._after_kept_settings(fields["span"])
         if isinstance(target, ir.JointTarget):
             self.out.append(make(target=target, **fields))
         else:
@@ -306,8 +415,15 @@ class Motions(InlineForms):
         if spline and approx in (("C_SPL",), ("C_DIS",)):
             return
         if base == "PTP":
-            valid = approx[0] == "C_PTP" and (len(approx) == 1 or approx[1:] in _ONE_CP_APPROX)
-            rule = "PTP approximates with C_PTP, optionally followed by C_DIS, C_ORI or C_VEL"
+            # KSS 8.2 and later: the PTP inline form with CONT writes PTP XP1 C_DIS, the
+            # distance criterion ($APO.CDIS) instead of $APO.CPTP.
+            valid = approx == ("C_DIS",) or (
+                approx[0] == "C_PTP" and (len(approx) == 1 or approx[1:] in _ONE_CP_APPROX)
+            )
+            rule = (
+                "PTP approximates with C_DIS, or with C_PTP optionally followed by C_DIS, "
+                "C_ORI or C_VEL"
+            )
         else:
             # The inline forms of KSS 8 write the keyword twice: LIN XP1 C_DIS C_DIS.
             doubled = len(approx) == 2 and approx[0] == approx[1]
@@ -499,3 +615,29 @@ def _offset(start: tuple[float, ...], delta: tuple[float, ...], option: str) -> 
         pose[:3, :3] = delta_pose[:3, :3] @ start_pose[:3, :3]
         pose[:3, 3] = start_pose[:3, 3] + delta_pose[:3, 3]
     return tuple(float(v) for v in pose_to_frame(pose))
+
+
+_MOTION_TEXT = re.compile(r"\s*(S?PTP|S?LIN|S?CIRC)(_REL)?\b", re.IGNORECASE)
+
+
+def _is_motion_text(text: str) -> bool:
+    return _MOTION_TEXT.match(text) is not None
+
+
+def _names_system(expr: Any) -> bool:
+    """Whether an assignment target is (part of) a system variable (``$APO.CPTP``)."""
+    while isinstance(expr, ir.Index | ir.Member):
+        expr = expr.base
+    return isinstance(expr, ir.Name) and expr.name.startswith("$")
+
+
+def _same(a: Any, b: Any) -> bool:
+    """Equal motion settings (tools and frames compared by name, number and pose)."""
+    if isinstance(a, ir.Tool | ir.Frame) and isinstance(b, ir.Tool | ir.Frame):
+        return (
+            type(a) is type(b)
+            and a.name == b.name
+            and a.number == b.number
+            and np.array_equal(np.asarray(a.pose), np.asarray(b.pose))
+        )
+    return bool(a == b)

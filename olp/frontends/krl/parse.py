@@ -343,8 +343,8 @@ class _ToAst(Transformer[Token, Module]):
         return DeclItem(str(name), dims, value, self._span(meta))
 
     @_inline
-    def dims(self, meta: Meta, args: tuple[Expr, ...] | None) -> tuple[Expr, ...]:
-        return args or ()
+    def dims(self, meta: Meta, args: tuple[Expr | None, ...]) -> tuple[Expr | None, ...]:
+        return args
 
     @_inline
     def signal_decl(

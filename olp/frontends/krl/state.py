@@ -121,6 +121,11 @@ class Track:
     def lose_cartesian(self, reason: str) -> None:
         self.cartesian, self.no_cartesian = None, reason
 
+    def lose(self, reason: str) -> None:
+        """The robot went where olp does not know: neither position nor axes are known."""
+        self.cartesian, self.no_cartesian = None, reason
+        self.joints, self.no_joints = None, reason
+
     def at_axes(self, degrees: tuple[float, ...], line: int) -> None:
         self.cartesian = None
         self.no_cartesian = f"the motion at line {line} went to axis values"
@@ -270,6 +275,9 @@ class Context:
         self.module_dat = dat
         self.shared = tuple(shared)
         self._where = self._describe_files(src)
+        # > 0 while a FOR body is tried with its counter unknown: a motion to a run-time
+        # target then fails the try, so that the loop is unrolled and its targets known
+        self.probing_for = 0
 
     def _describe_files(self, src: str) -> str:
         dat = (
@@ -286,6 +294,7 @@ class Context:
                 "$H_POS is not set by the program (the controller keeps it in $machine.dat, "
                 "which olp does not read)",
                 "set it in the program ($H_POS=XHOME) or move to XHOME directly",
+                missing=True,  # a value of the controller's files, not of the run
             )
         if name.startswith("$"):
             return Unknown(f"{name} is a controller variable olp does not track")
@@ -305,7 +314,8 @@ class Context:
                 "a point declared GLOBAL in another module's PUBLIC data list is found with "
                 "--data-list FILE.dat or --data-lists-from FOLDER (KrlOptions(data_lists=...))"
             )
-        return Unknown(f"{name} is not declared in {self._where}", "; ".join(hints) or None)
+        where = f"{name} is not declared in {self._where}"
+        return Unknown(where, "; ".join(hints) or None, missing=True)
 
     def spend(self, stmt: Stmt) -> None:
         self.remaining -= 1
@@ -327,7 +337,7 @@ def data_file_name(data: KrlData) -> str:
 # The core of a lowering
 
 
-HERE = frozenset({"$POS_ACT", "$AXIS_ACT", "$POS_ACT_MES", "$AXIS_ACT_MES"})
+HERE = frozenset({"$POS_ACT", "$AXIS_ACT", "$POS_ACT_MES", "$AXIS_ACT_MEAS", "$AXIS_ACT_MES"})
 """Targets that are where the robot stands when the motion starts."""
 
 
@@ -460,6 +470,11 @@ class Core:
             raise self._error(f"{what} takes one index", target.span)
         return self._integer(index.args[0], f"the index of {what}", minimum)
 
+    @staticmethod
+    def _runtime(value: Value) -> bool:
+        """Whether ``value`` is known only when the program runs (not for a missing name)."""
+        return isinstance(value, Unknown) and not value.missing
+
     def _aggregate(self, expr: Expr, what: str, hint: str | None = None) -> Aggregate:
         """The aggregate ``expr`` stands for (inline, or a variable's value)."""
         value = self._value(expr)
@@ -491,7 +506,9 @@ class Core:
             else:
                 self.here_vars.pop(name, None)
             self.data.assign(stmt)  # what olp knows of the value afterwards
-            if stmt.target.name.upper() not in INLINE_FORM_DATA:
+            if name not in INLINE_FORM_DATA or self._runtime(self.variables.lookup(name)):
+                # PDAT_ACT = pdatNew with a run-time value: the BAS reading it is kept as
+                # written, so the assignment must reach the output too
                 self.out.append(self._assignment(stmt))
 
     def _set_vel_cp(self, name: str, value: Expr, stmt: Stmt) -> None:
@@ -531,6 +548,7 @@ class Core:
         if distance < 0:
             raise self._error(f"{what} must be >= 0", span)
         self.state = dataclasses.replace(self.state, cdis_mm=distance)
+        self._settled("cdis_mm")  # the same number object again: identity cannot tell
 
     def _set_struct(self, name: str, value: Expr, stmt: Stmt) -> None:
         """``$VEL = {CP 0.5, ...}``: each component as its own assignment; a motion parameter
@@ -632,9 +650,11 @@ class Core:
                 f"{name} must be one of {names}, found {self.sources.snippet(span)!r}", span
             )
         if name == "$ORI_TYPE":
-            self.state = dataclasses.replace(self.state, ori_type=found)
+            self.state, field_name = dataclasses.replace(self.state, ori_type=found), "ori_type"
         else:
             self.state = dataclasses.replace(self.state, circ_type=found)
+            field_name = "circ_type"
+        self._settled(field_name)  # an interned name: identity cannot tell it was set
 
     def _ipo_mode(self, mode: Value, span: ir.SourceSpan) -> None:
         if isinstance(mode, EnumValue) and mode.name.upper() == "BASE":

@@ -69,10 +69,16 @@ class Signal:
 
 @dataclass(frozen=True, slots=True)
 class Unknown:
-    """A value olp does not know, and why (shown to the user when a statement needs it)."""
+    """A value olp does not know, and why (shown to the user when a statement needs it).
+
+    ``missing``: a value missing from olp's input or from the program itself, not one the
+    controller computes as it runs: a name it depends on is declared nowhere olp looked (a data
+    list or ``$config.dat`` not given), or a local variable is read before the program gives it
+    a value (the controller stops there too)."""
 
     reason: str
     hint: str | None = None
+    missing: bool = False
 
 
 Const: TypeAlias = Num | Bool | Text | Bits | EnumValue | Aggregate | ArrayValue | Signal
@@ -207,7 +213,9 @@ class Evaluator:
             number = as_int(value)
             if number is None:
                 reason = value.reason if isinstance(value, Unknown) else "it is not an integer"
-                return Unknown(f"the index {self._snippet(arg.span)!r} is not constant: {reason}")
+                missing = isinstance(value, Unknown) and value.missing
+                message = f"the index {self._snippet(arg.span)!r} is not constant: {reason}"
+                return Unknown(message, missing=missing)
             key.append(number)
         return tuple(key)
 
