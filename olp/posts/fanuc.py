@@ -75,6 +75,11 @@ endings (the files are DOS text; medium confidence that LF would also do).
   default of 9999 lines per program (``MAX_LINES_X_PROG``; not a documented Fanuc figure),
   applied as 3000 instructions per file: an instruction takes at most three /MN lines
   (``UFRAME_NUM``, ``UTOOL_NUM``, the motion) unless it is a long comment.
+* A dense toolpath (:class:`~olp.ir.LinearPath`) is written from columns (:attr:`COLUMNS
+  <olp.posts.base.Post.COLUMNS>`, :mod:`olp.posts.fanuc_rows`): its rows' ``L`` lines and
+  ``/POS`` entries are formatted as arrays, the same text as the template writes move by move
+  (``tests/posts/test_fanuc_columns.py``); runs of ordinary linear moves go to the row writer
+  (:func:`ls_rows_mn`, :func:`ls_rows_pos`), everything else to the template.
 """
 
 from __future__ import annotations
@@ -265,7 +270,8 @@ def ls_moves(
     one file (template view steps, in order), by instruction index. Positions are numbered from
     1 in each file; ``UFRAME_NUM``/``UTOOL_NUM`` are set before the file's first motion, where
     they change, and at the first motion after a block boundary or label (the motion before it
-    in the text need not be the one that ran: :data:`JUMP_TARGETS`)."""
+    in the text need not be the one that ran: :data:`JUMP_TARGETS`). A toolpath's rows
+    (:class:`~olp.posts.view.RowColumns`) are one :class:`~olp.posts.fanuc_rows.LsColumns`."""
     out: dict[int, LsMove | LsRows | LsColumns] = {}
     last: tuple[int, int] | None = None
     number = 0
