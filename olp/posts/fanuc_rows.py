@@ -27,7 +27,9 @@ if TYPE_CHECKING:
     from olp.posts.view import PostStep, RowColumns
 
 FloatArray = NDArray[np.float64]
-Texts = NDArray[np.str_]
+Texts = NDArray[np.bytes_]
+"""Texts as ASCII bytes: numpy's str arrays (UTF-32) move four times the memory when columns
+are joined; what an LS file holds is ASCII (the manifest's encoding)."""
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -72,17 +74,17 @@ def position_texts(post: Post, rows: RowColumns, first: int, uf: int, ut: int) -
     this order: the Cartesian rows' X, Y, Z, then their W, P, R, then the joint rows."""
     configs = rows.column("config")
     cartesian = configured(configs)
-    numbers = np.arange(first, first + len(rows)).astype(np.str_)
-    head = np.strings.add(np.strings.add("P[", numbers), f"]{{\n   GP1:\n\tUF : {uf}, UT : {ut},")
+    numbers = np.arange(first, first + len(rows)).astype(np.bytes_)
+    head = _join(b"P[", numbers, f"]{{\n   GP1:\n\tUF : {uf}, UT : {ut},".encode())
     out = np.empty(len(rows), dtype=object)
     where = np.flatnonzero(cartesian)
     if where.size:
-        text = _cartesian(post, rows, where, uf, head[where], configs[where].astype(np.str_))
+        text = _cartesian(post, rows, where, uf, head[where], configs[where].astype(np.bytes_))
         out[where] = text
     joints = np.flatnonzero(~cartesian)
     if joints.size:
         out[joints] = _joints(post, rows, joints, head[joints])
-    return "".join(out.tolist())
+    return b"".join(out.tolist()).decode("ascii")
 
 
 def _cartesian(
@@ -95,16 +97,16 @@ def _cartesian(
         poses = rows.motions.frame_pose @ poses
     values = pose_to_xyzwpr(poses)
     at = _rows_at(rows, where)
-    xyz = post.number_texts("position", values[:, :3], at)
-    wpr = post.number_texts("angle", values[:, 3:], at)
-    out = _join(head, "\t\tCONFIG : '", configs, "',\n\tX = ")
+    xyz = post.number_texts("position", values[:, :3], at).astype(np.bytes_)
+    wpr = post.number_texts("angle", values[:, 3:], at).astype(np.bytes_)
+    out = _join(head, b"\t\tCONFIG : '", configs, b"',\n\tX = ")
     fields = (
-        (xyz[:, 0], "  mm,\tY = "),
-        (xyz[:, 1], "  mm,\tZ = "),
-        (xyz[:, 2], "  mm,\n\tW = "),
-        (wpr[:, 0], " deg,\tP = "),
-        (wpr[:, 1], " deg,\tR = "),
-        (wpr[:, 2], " deg\n};\n"),
+        (xyz[:, 0], b"  mm,\tY = "),
+        (xyz[:, 1], b"  mm,\tZ = "),
+        (xyz[:, 2], b"  mm,\n\tW = "),
+        (wpr[:, 0], b" deg,\tP = "),
+        (wpr[:, 1], b" deg,\tR = "),
+        (wpr[:, 2], b" deg\n};\n"),
     )
     for column, after in fields:
         out = _join(out, np.strings.rjust(column, 9), after)
@@ -116,10 +118,10 @@ def _joints(post: Post, rows: RowColumns, where: NDArray[np.intp], head: Texts) 
     block = rows.piece.block
     assert block.joints is not None
     degrees = np.degrees(block.joints[rows.piece.lo + where])
-    values = post.number_texts("angle", degrees, _rows_at(rows, where))
-    out = np.strings.add(head, "\n\tJ1=")
-    after = (" deg,\tJ2=", " deg,\tJ3=", " deg,\n\tJ4=", " deg,\tJ5=", " deg,\tJ6=", " deg\n};\n")
-    for j, text in enumerate(after):
+    values = post.number_texts("angle", degrees, _rows_at(rows, where)).astype(np.bytes_)
+    out = np.strings.add(head, b"\n\tJ1=")
+    after = [b" deg,\tJ2=", b" deg,\tJ3=", b" deg,\n\tJ4=", b" deg,\tJ5=", b" deg,\tJ6="]
+    for j, text in enumerate([*after, b" deg\n};\n"]):
         out = _join(out, np.strings.rjust(values[:, j], 10), text)
     return out
 
@@ -133,25 +135,23 @@ def mn_lines(post: Post, moves: LsColumns) -> str:
     every = np.arange(len(rows))
     at = _rows_at(rows, every)
     mm = np.maximum(1.0, np.floor(rows.speeds * 1000.0 + 0.5))
-    speeds = post.number_texts("linear", mm, at)
+    speeds = post.number_texts("linear", mm, at).astype(np.bytes_)
     zones = rows.zones
-    terms = np.full(len(rows), "FINE", dtype="<U7")
+    terms = np.full(len(rows), b"FINE", dtype="S7")
     blended = np.flatnonzero(zones > 0)
     if blended.size:
         cnt = np.minimum(100.0, np.floor(zones[blended] * 1000.0 + 0.5))
-        terms[blended] = np.strings.add(
-            "CNT", post.number_texts("cnt", cnt, _rows_at(rows, blended))
-        )
-    numbers = np.arange(moves.first, moves.first + len(rows)).astype(np.str_)
-    lines = _join(np.strings.add("L P[", numbers), "] ", speeds, "mm/sec ")
-    lines = _join(lines, terms, "    ;")
+        cnt_texts = post.number_texts("cnt", cnt, _rows_at(rows, blended)).astype(np.bytes_)
+        terms[blended] = np.strings.add(b"CNT", cnt_texts)
+    numbers = np.arange(moves.first, moves.first + len(rows)).astype(np.bytes_)
+    lines = _join(b"L P[", numbers, b"] ", speeds, b"mm/sec ", terms, b"    ;")
     head = []
     if moves.set_uf:
         head.append(f"  UFRAME_NUM={moves.uf} ;")
     if moves.set_ut:
         head.append(f"  UTOOL_NUM={moves.ut} ;")
     post.current_step = rows
-    return "\n".join([*head, *lines.tolist()])
+    return "\n".join([*head, b"\n".join(lines.tolist()).decode("ascii")])
 
 
 def configured(configs: NDArray[np.object_]) -> NDArray[np.bool_]:
@@ -169,7 +169,7 @@ def _rows_at(rows: RowColumns, where: NDArray[np.intp]) -> Callable[[int], PostS
     return lambda j: rows.at(int(where[j]))
 
 
-def _join(*parts: Texts | str) -> Texts:
+def _join(*parts: Texts | bytes) -> Texts:
     """The texts (n,) of ``parts`` (arrays (n,) or one text for all) joined row by row."""
     out = np.strings.add(parts[0], parts[1])
     for part in parts[2:]:
