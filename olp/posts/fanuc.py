@@ -75,12 +75,18 @@ endings (the files are DOS text; medium confidence that LF would also do).
   default of 9999 lines per program (``MAX_LINES_X_PROG``; not a documented Fanuc figure),
   applied as 3000 instructions per file: an instruction takes at most three /MN lines
   (``UFRAME_NUM``, ``UTOOL_NUM``, the motion) unless it is a long comment.
+* A dense toolpath (:class:`~olp.ir.LinearPath`) is written from columns (:attr:`COLUMNS
+  <olp.posts.base.Post.COLUMNS>`, :mod:`olp.posts.fanuc_rows`): its rows' ``L`` lines and
+  ``/POS`` entries are formatted as arrays, the same text as the template writes move by move
+  (``tests/posts/test_fanuc_columns.py``); runs of ordinary linear moves go to the row writer
+  (:func:`ls_rows_mn`, :func:`ls_rows_pos`), everything else to the template.
 """
 
 from __future__ import annotations
 
 import math
 import re
+import weakref
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar
@@ -88,24 +94,27 @@ from typing import TYPE_CHECKING, Any, ClassVar
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from olp.compiled import PathBlock, Step, items_of
 from olp.diagnostics import Diagnostic
 from olp.geometry import inv
 from olp.posts.base import Filter, Post
 from olp.posts.fanuc_flow import FLOW_KINDS, lower
+from olp.posts.fanuc_rows import LsColumns, column_moves, configured, mn_lines
 from olp.posts.numbers import NumberError, NumberFormat, Storage
 from olp.posts.rows import PostRows
 from olp.posts.sandbox import SafeText
 from olp.posts.text import ArgumentRule, CommentRule, NameRule
+from olp.posts.view import RowColumns
 from olp.vendors.fanuc import (
     candidates,
     config_from_joints,
     has_config,
     pose_to_xyzwpr,
-    selecting_configs,
+    selecting_config_column,
 )
 
 if TYPE_CHECKING:
-    from olp.compiled import CompiledProgram, Step
+    from olp.compiled import CompiledProgram
     from olp.posts.view import PostStep
 
 FloatArray = NDArray[np.float64]
@@ -253,21 +262,30 @@ class LsRows:
 
 def ls_moves(
     post: Post,
-    steps: Sequence[PostStep | PostRows],
+    steps: Sequence[PostStep | PostRows | RowColumns],
     robot: Any,
     options: Mapping[str, Any] | None = None,
-) -> dict[int, LsMove | LsRows]:
+) -> dict[int, LsMove | LsRows | LsColumns]:
     """Template filter ``steps | ls_moves(robot, options)``: the LS motion of every motion of
     one file (template view steps, in order), by instruction index. Positions are numbered from
     1 in each file; ``UFRAME_NUM``/``UTOOL_NUM`` are set before the file's first motion, where
     they change, and at the first motion after a block boundary or label (the motion before it
-    in the text need not be the one that ran: :data:`JUMP_TARGETS`)."""
-    out: dict[int, LsMove | LsRows] = {}
+    in the text need not be the one that ran: :data:`JUMP_TARGETS`). A toolpath's rows
+    (:class:`~olp.posts.view.RowColumns`) are one :class:`~olp.posts.fanuc_rows.LsColumns`."""
+    out: dict[int, LsMove | LsRows | LsColumns] = {}
     last: tuple[int, int] | None = None
     number = 0
     for step in steps:
         if step.kind in JUMP_TARGETS:
             last = None
+            continue
+        if isinstance(step, RowColumns):
+            block = step.piece.block
+            uf, ut = uframe_number(block.frame), utool_number(block.tool, options)
+            post.current_step = step
+            columns = column_moves(post, step, number, last, uf, ut)
+            out[step.index] = columns
+            number, last = columns.last, (uf, ut)
             continue
         if isinstance(step, PostRows):
             moves = _row_moves(post, step, number, last, options)
@@ -298,7 +316,7 @@ JUMP_TARGETS = FLOW_KINDS - {"declare", "assign", "wait_until", "goto", "exit", 
 
 
 def ls_flow(
-    post: Post, steps: Sequence[PostStep | PostRows], options: Mapping[str, Any]
+    post: Post, steps: Sequence[PostStep | PostRows | RowColumns], options: Mapping[str, Any]
 ) -> tuple[SafeText, ...]:
     """Template filter ``steps | ls_flow(options)``: per step of a file (by position), the /MN
     lines of a control-flow or data step (:func:`olp.posts.fanuc_flow.lower`), empty for any
@@ -354,9 +372,12 @@ def _row_moves(
     return tuple(out)
 
 
-def ls_rows_mn(post: Post, moves: LsRows) -> SafeText:
+def ls_rows_mn(post: Post, moves: LsRows | LsColumns) -> SafeText:
     """The ``/MN`` lines of a run of linear moves, exactly as ``program.ls.j2`` writes each:
-    ``UFRAME_NUM``/``UTOOL_NUM`` where they change, then ``L P[n] v mm/sec term``."""
+    ``UFRAME_NUM``/``UTOOL_NUM`` where they change, then ``L P[n] v mm/sec term`` (a
+    toolpath's rows as columns: :func:`olp.posts.fanuc_rows.mn_lines`)."""
+    if isinstance(moves, LsColumns):
+        return SafeText(mn_lines(post, moves))
     speeds: dict[Any, str] = {}
     terms: dict[Any, str] = {}
     lines = []
@@ -377,9 +398,11 @@ def ls_rows_mn(post: Post, moves: LsRows) -> SafeText:
     return SafeText("\n".join(lines))
 
 
-def ls_rows_pos(post: Post, moves: LsRows) -> SafeText:
+def ls_rows_pos(post: Post, moves: LsRows | LsColumns) -> SafeText:
     """The ``/POS`` entries of a run of linear moves, exactly as the template's ``position``
     macro writes each (each entry ends with its line break)."""
+    if isinstance(moves, LsColumns):
+        return SafeText(moves.positions)
     return SafeText("".join(_position_text(move.target) for move in moves.moves))
 
 
@@ -497,6 +520,7 @@ class FanucPost(Post):
     VENDOR = "fanuc"
     LANGUAGE = "LS"
     ROWS = True
+    COLUMNS = True
     WRITES_FLOW = True
     NAME_RULE = NAME_RULE
     COMMENTS = CommentRule(max_length=COMMENT_LENGTH, replace=((";", ","),), collapse=True)
@@ -508,6 +532,7 @@ class FanucPost(Post):
     def __init__(self, manifest: Any) -> None:
         super().__init__(manifest)
         self._configs: dict[int, tuple[Any, _SelectionMemo]] = {}
+        self._columns: dict[int, tuple[weakref.ref[Any], Any, NDArray[np.object_]]] = {}
 
     def check_instruction(self, step: Step, compiled: CompiledProgram) -> list[Diagnostic]:
         """``speed_raised`` (warning): a speed LS cannot write so slow, written at its least
@@ -528,25 +553,62 @@ class FanucPost(Post):
         )
         return [Diagnostic("warning", "speed_raised", message, ins.span, step.index)]
 
+    def check_rows(self, block: PathBlock, compiled: CompiledProgram) -> list[Diagnostic]:
+        """:meth:`check_instruction` of a toolpath's rows (linear moves), from its speeds:
+        ``speed_raised`` on each row whose speed rounds below 1mm/sec, in row order."""
+        given = block.node.speeds * 1000.0
+        raised = np.flatnonzero(np.floor(given + 0.5) < 1)
+        out = []
+        for k in raised.tolist():
+            message = (
+                f"speed {float(given[k]):.3g} mm/sec is below the least LS can write; written "
+                "as 1mm/sec, faster than programmed"
+            )
+            span = block.node.row_span(k)
+            out.append(Diagnostic("warning", "speed_raised", message, span, block.start + k))
+        return out
+
     def step_values(self, robot: Any, joints: Any) -> list[Mapping[str, Any]]:
         """Per planned motion (joints (N, 6) rad) ``{"config": str | None}``, the CONFIG a
         Cartesian position gets (:func:`olp.vendors.fanuc.selecting_configs`)."""
         return [{"config": c} for c in self.selecting_configs(robot, joints)]
 
+    def step_columns(self, robot: Any, joints: Any) -> Mapping[str, Any]:
+        """:meth:`step_values` of a toolpath's rows (joints (N, 6) rad) as columns:
+        ``{"config": array (N,)}`` of CONFIG texts (each distinct text one object) and None
+        (:func:`olp.vendors.fanuc.selecting_config_column`).
+
+        Remembered per joints array while it lives (the checks and the render ask for the same
+        block's array), rather than per row as :meth:`selecting_configs` remembers: a
+        million rows in a few hundred blocks would re-sort the row memo once per block."""
+        key = id(joints)
+        known = self._columns.get(key)
+        if known is None or known[0]() is not joints or known[1] is not robot:
+            column = selecting_config_column(robot, joints)
+            columns = self._columns
+            known = (weakref.ref(joints, lambda _: columns.pop(key, None)), robot, column)
+            columns[key] = known
+        return {"config": known[2]}
+
     def selecting_configs(self, robot: Any, joints: Any) -> list[str | None]:
         """:func:`olp.vendors.fanuc.selecting_configs`, remembered per joint vector for this
         post and robot: the checks and the render ask for the same motions (an IK per row)."""
+        configs: list[str | None] = self.config_column(robot, joints).tolist()
+        return configs
+
+    def config_column(self, robot: Any, joints: Any) -> NDArray[np.object_]:
+        """:meth:`selecting_configs` as an array (N,) of objects (a CONFIG text or None;
+        :func:`olp.vendors.fanuc.selecting_config_column`)."""
         q = np.ascontiguousarray(joints, dtype=np.float64).reshape(-1, 6)
         memo = self._configs.get(id(robot))
         if memo is None or memo[0] is not robot:
             memo = self._configs[id(robot)] = (robot, _SelectionMemo())
         out, missing = memo[1].lookup(q)
         if missing.size:
-            found = np.empty(missing.size, dtype=object)
-            found[:] = selecting_configs(robot, q[missing])
+            found = selecting_config_column(robot, q[missing])
             memo[1].add(q[missing], found)
             out[missing] = found
-        return list(out)
+        return out
 
     def check_program(self, compiled: CompiledProgram) -> list[Diagnostic]:
         """Frame and tool numbers LS cannot write (errors), a tool number olp chose (warning,
@@ -554,10 +616,17 @@ class FanucPost(Post):
         relies on (info), Cartesian targets written as joints because no CONFIG selects them
         alone (info)."""
         robot = compiled.station.robot
-        motions = [s for s in compiled.steps if s.joints is not None]
-        out = _frame_checks(self, motions, robot)
-        out += _tool_checks(self, motions, self.options)
+        motions = _motions(compiled)
+        firsts = [m.step(0) if isinstance(m, PathBlock) else m for m in motions]
+        out = _frame_checks(self, firsts, robot)
+        out += _tool_checks(self, firsts, self.options)
         return out + _joint_position_notes(self, motions, robot) + _flow_checks(self, compiled)
+
+
+def _motions(compiled: CompiledProgram) -> list[Step | PathBlock]:
+    """The planned motions of ``compiled`` in order: steps with joints, and toolpath blocks
+    (their rows, all with joints, as one item)."""
+    return [item for item in items_of(compiled.steps) if item.joints is not None]
 
 
 def _flow_checks(post: Post, compiled: CompiledProgram) -> list[Diagnostic]:
@@ -666,24 +735,39 @@ def _tool_checks(
     return out
 
 
-def _joint_position_notes(post: FanucPost, motions: Sequence[Any], robot: Any) -> list[Diagnostic]:
-    """Info per Cartesian target written in joint form (no CONFIG selects it alone)."""
+def _joint_position_notes(
+    post: FanucPost, motions: Sequence[Step | PathBlock], robot: Any
+) -> list[Diagnostic]:
+    """Info per Cartesian target written in joint form (no CONFIG selects it alone); a
+    toolpath's rows (all Cartesian) from their column of CONFIGs."""
     from olp.ir import CartesianTarget
 
-    cartesian = [s for s in motions if isinstance(s.instruction.target, CartesianTarget)]
-    if not cartesian:
-        return []
-    joints = np.stack([np.asarray(s.joints, dtype=np.float64) for s in cartesian])
+    steps = [
+        m
+        for m in motions
+        if isinstance(m, Step) and isinstance(m.instruction.target, CartesianTarget)  # type: ignore[union-attr]
+    ]
+    configs: dict[int, str | None] = {}
+    if steps:
+        joints = np.stack([np.asarray(s.joints, dtype=np.float64) for s in steps])
+        found = post.selecting_configs(robot, joints)
+        configs = {s.index: c for s, c in zip(steps, found, strict=True)}
     out: list[Diagnostic] = []
-    for step, config in zip(cartesian, post.selecting_configs(robot, joints), strict=True):
-        if config is None:
-            msg = (
-                "Cartesian target written as joint values: no CONFIG selects the planned "
-                "joints alone (an arm without CONFIG, a wrist singularity, or a J3 range "
-                "holding two turns)"
-            )
-            out.append(_diag("info", "joint_position", msg, step))
+    for item in motions:
+        if isinstance(item, PathBlock):
+            column = post.step_columns(robot, item.joints)["config"]
+            for k in np.flatnonzero(~configured(column)).tolist():
+                note = (_JOINT_POSITION, item.node.row_span(k), item.start + k)
+                out.append(Diagnostic("info", "joint_position", *note))
+        elif configs.get(item.index, "") is None:
+            out.append(_diag("info", "joint_position", _JOINT_POSITION, item))
     return out
+
+
+_JOINT_POSITION = (
+    "Cartesian target written as joint values: no CONFIG selects the planned joints alone (an "
+    "arm without CONFIG, a wrist singularity, or a J3 range holding two turns)"
+)
 
 
 def _written(post: Post, pose: ArrayLike) -> str:

@@ -308,9 +308,12 @@ class RowColumns:
         )
 
 
-def _row_value(value: NDArray[Any]) -> Any:
+def _row_value(value: Any) -> Any:
     """One row of a post's column as :meth:`ViewHooks.step_values` gives it: a Python scalar,
-    or a tuple of them for a column of several values per row (ABB's confdata, (n, 4))."""
+    a tuple of them for a column of several values per row (ABB's confdata, (n, 4)), or the
+    object itself from a column of objects (Fanuc's CONFIG texts and None)."""
+    if not isinstance(value, np.ndarray | np.generic):
+        return value
     return value.item() if value.ndim == 0 else tuple(value.tolist())
 
 

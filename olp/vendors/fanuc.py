@@ -243,13 +243,22 @@ def selecting_configs(robot: Any, joints: ArrayLike) -> list[str | None]:
     is); robots whose shoulder or elbow flag would depend on more than J2 and J3 take the
     reference. Batches of :data:`SELECT_ROWS` bound the memory.
     """
+    result: list[str | None] = selecting_config_column(robot, joints).tolist()
+    return result
+
+
+def selecting_config_column(robot: Any, joints: ArrayLike) -> NDArray[np.object_]:
+    """:func:`selecting_configs` as an array (N,) of objects: the CONFIG text (each distinct
+    text one ``str`` object, shared by its rows) or None, with no Python object made per row
+    (a toolpath's rows: the LS post's column writer, :mod:`olp.posts.fanuc_rows`)."""
     q = np.asarray(joints, dtype=np.float64).reshape(-1, 6)
+    out = np.full(q.shape[0], None, dtype=object)
     if q.shape[0] == 0 or not has_config(robot):
-        return [None] * q.shape[0]
+        return out
     select = _selecting_configs if _flags_follow_j2_j3(robot) else _selecting_configs_reference
-    out: list[str | None] = []
     for lo in range(0, q.shape[0], SELECT_ROWS):
-        out += select(robot, q[lo : lo + SELECT_ROWS])
+        hi = min(lo + SELECT_ROWS, q.shape[0])
+        out[lo:hi] = select(robot, q[lo:hi])
     return out
 
 
@@ -277,9 +286,10 @@ _PACK = 1 << 16
 """Range of one packed turn number in :func:`_config_texts` (8 x 2**48 fits an int64)."""
 
 
-def _config_texts(q: FloatArray, flags: Any) -> list[str]:
+def _config_texts(q: FloatArray, flags: Any) -> NDArray[np.object_]:
     """The CONFIG text (:class:`FanucConfig`) of each joint vector (n, 6) rad with its branch
-    flags, each distinct value formatted once."""
+    flags, as an array (n,) of objects: each distinct value formatted once, one ``str`` shared
+    by its rows."""
     turns = turn_number(q[:, list(TURN_AXES)])
     codes = np.column_stack([flags.flip, flags.down, flags.back, turns]).astype(np.int64)
     if np.all((turns > -_PACK // 2) & (turns < _PACK // 2)):  # a 1-d unique is ~10x faster
@@ -290,11 +300,13 @@ def _config_texts(q: FloatArray, flags: Any) -> list[str]:
         distinct = codes[first]
     else:
         distinct, inverse = np.unique(codes, axis=0, return_inverse=True)
-    texts = [
+    texts = np.empty(len(distinct), dtype=object)
+    texts[:] = [
         str(FanucConfig(not f, not d, not b, (int(t1), int(t4), int(t6))))
         for f, d, b, t1, t4, t6 in distinct.tolist()
     ]
-    return [texts[k] for k in inverse.reshape(-1).tolist()]
+    picked: NDArray[np.object_] = texts[inverse.reshape(-1)]
+    return picked
 
 
 def _selecting_configs_reference(robot: Any, q: FloatArray) -> list[str | None]:
@@ -338,7 +350,7 @@ def _flags_follow_j2_j3(robot: Any) -> bool:
     return bool(np.all(rows[:, others] == 0))
 
 
-def _selecting_configs(robot: Any, q: FloatArray) -> list[str | None]:
+def _selecting_configs(robot: Any, q: FloatArray) -> NDArray[np.object_]:
     """:func:`selecting_configs` of one batch (n, 6) rad, equal result for result to
     :func:`_selecting_configs_reference` (tests/vendors/test_fanuc_selection.py).
 
@@ -400,7 +412,8 @@ def _selecting_configs(robot: Any, q: FloatArray) -> list[str | None]:
     count_ok = _count(ok, xe)
     count_near = _count(near, xe)
     selected = (count_ok.sum(axis=-1) > 0) & (count_ok.sum(axis=-1) == count_near.sum(axis=-1))
-    return [c if keep else None for c, keep in zip(configs, selected.tolist(), strict=True)]
+    configs[~selected] = None
+    return configs
 
 
 _VARIANT_TOLERANCE = 1e-9
