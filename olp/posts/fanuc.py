@@ -104,7 +104,7 @@ from olp.posts.numbers import NumberError, NumberFormat, Storage
 from olp.posts.rows import PostRows
 from olp.posts.sandbox import SafeText
 from olp.posts.text import ArgumentRule, CommentRule, NameRule
-from olp.posts.view import RowColumns
+from olp.posts.view import OPAQUE_KINDS, RowColumns
 from olp.vendors.fanuc import (
     candidates,
     config_from_joints,
@@ -270,14 +270,15 @@ def ls_moves(
     one file (template view steps, in order), by instruction index. Positions are numbered from
     1 in each file; ``UFRAME_NUM``/``UTOOL_NUM`` are set before the file's first motion, where
     they change, and at the first motion after a block boundary or label (the motion before it
-    in the text need not be the one that ran: :data:`JUMP_TARGETS`). A toolpath's rows
+    in the text need not be the one that ran: :data:`JUMP_TARGETS`) or a call (which may set
+    others: :data:`~olp.posts.view.OPAQUE_KINDS`). A toolpath's rows
     (:class:`~olp.posts.view.RowColumns`) are one :class:`~olp.posts.fanuc_rows.LsColumns`."""
     out: dict[int, LsMove | LsRows | LsColumns] = {}
     last: tuple[int, int] | None = None
     number = 0
     for step in steps:
-        if step.kind in JUMP_TARGETS:
-            last = None
+        if step.kind in JUMP_TARGETS or step.kind in OPAQUE_KINDS:
+            last = None  # arrived from elsewhere, or a called routine may have set others
             continue
         if isinstance(step, RowColumns):
             block = step.piece.block

@@ -110,7 +110,8 @@ class PostStep:
     * ``cartesian``: the source gave a Cartesian target.
     * ``new_tool``, ``new_frame``, ``new_linear_speed``, ``new_joint_speed``, ``new_zone``:
       the value differs from the previous motion's *in this file* (each file starts afresh, so
-      a part never relies on state set by another).
+      a part never relies on state set by another), or a call or kept line
+      (:data:`OPAQUE_KINDS`) came between, which may have changed any of them.
     * ``motion`` (added): 1-based number of the motion in the whole program.
     * ``name`` (added): a legal identifier for the target, unique in the program (the manifest
       option ``point_names``, default ``"P{n}"``, with ``n`` = ``motion``).
@@ -514,6 +515,8 @@ class ProgramView:
             if not isinstance(ins, MOTION_TYPES):
                 lines = self.post.comment_lines(ins.text) if ins.kind == "comment" else ()
                 out.append(PostStep(step.index, ins.kind, ins.span.location, ins, comment=lines))
+                if ins.kind in OPAQUE_KINDS:
+                    last.clear()  # the next motion sets everything again
             elif step.index in self.motions:
                 out.append(self._motion_step(step, names, last))
         return out
@@ -592,6 +595,12 @@ class ProgramView:
             new_joint_speed=new_joint_speed,
             new_linear_speed=new_linear_speed,
         )
+
+
+OPAQUE_KINDS = frozenset({"call", "verbatim"})
+"""Instructions that may change the controller's motion settings (a called routine, a kept
+line olp does not model: either may set another tool, base, speed or zone): the first motion
+after one gets every ``new_*`` flag, so the post writes all its settings again."""
 
 
 def _changed_object(last: dict[str, Any], key: str, value: Any) -> bool:
