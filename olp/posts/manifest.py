@@ -27,6 +27,9 @@ The manifest says::
                                       # false: a folder copied before olp wrote them, which
                                       # would write every block's body unconditionally; a post
                                       # that checks it stops on a program with control flow)
+    routines: true                    # the templates write the program's routines (default
+                                      # false: a folder copied before olp wrote them gets each
+                                      # routine's body written out at every call instead)
     options: {...}                    # free-form: templates see them as `options`, and so does
                                       # the post class
 
@@ -69,6 +72,7 @@ class PostManifest:
     rows: bool = False
     accelerations: bool = False
     flow: bool = False
+    routines: bool = False
 
 
 def load_manifest(folder: Path) -> PostManifest:
@@ -86,7 +90,8 @@ def load_manifest(folder: Path) -> PostManifest:
     frames_in = str(raw.get("frames_in", "world"))
     if frames_in not in FRAMES_IN:
         raise PostError(f"{path}: frames_in must be one of {', '.join(FRAMES_IN)}")
-    rows, accelerations, flow = (_flag(raw, key, path) for key in ("rows", "accelerations", "flow"))
+    flags = ("rows", "accelerations", "flow", "routines")
+    rows, accelerations, flow, routines = (_flag(raw, key, path) for key in flags)
     return PostManifest(
         name=str(raw.get("name", folder.name)),
         vendor=str(raw.get("vendor", "")),
@@ -102,6 +107,7 @@ def load_manifest(folder: Path) -> PostManifest:
         rows=rows,
         accelerations=accelerations,
         flow=flow,
+        routines=routines,
     )
 
 

@@ -26,6 +26,10 @@ Template context (every file)
     In ``main_files``: the parts in call order, each ``{name, index, routine}``; else empty.
 ``steps``
     This file's instructions (:class:`olp.posts.view.PostStep`); empty in ``main_files``.
+``routines``
+    Where the post writes routines (``Post.writes_routines``): the program's routines, each
+    a :class:`olp.posts.flow.RoutineSteps` (``routine``: the :class:`olp.ir.Routine`,
+    ``steps``: its body as steps); else empty.
 ``tools`` / ``frames``
     The tools and frames this file's motions use (the main: all of the program's), each a
     :class:`~olp.posts.view.PostTool` / :class:`~olp.posts.view.PostFrame` with a legal unique
@@ -53,7 +57,7 @@ from olp.compiled import BlockRows, PathBlock, StepBlocks, items_of, pieces
 from olp.diagnostics import Diagnostic
 from olp.errors import PostError
 from olp.ir import is_motion
-from olp.posts.flow import weave
+from olp.posts.flow import RoutineSteps, weave, weave_routines
 from olp.posts.rows import PostRows
 from olp.posts.text import basename
 from olp.posts.view import (
@@ -257,10 +261,15 @@ class _Renderer:
         unit_name: str | None = None,
     ) -> dict[str, Any]:
         view: Sequence[Any] = self.view.unit_steps(steps, allocation)
+        tools, frames = _used(allocation, view)  # a routine's motions are among these
+        routines: list[RoutineSteps] = []
         if self.post.WRITES_FLOW and self.compiled.program.has_flow:
             # a program with control flow is rendered from steps only (Post.columns_enabled)
+            if self.post.writes_routines():
+                lines = self.post.comment_lines
+                routines = weave_routines(self.compiled.program, view, lines)
+                routines = [RoutineSteps(r.routine, self._tracked(r.steps)) for r in routines]
             view = weave(self.compiled.program, view)
-        tools, frames = _used(allocation, view)
         name = unit_name or self.name
         return {
             "program": {"name": name, "source": self.source, "main": self.name},
@@ -274,7 +283,8 @@ class _Renderer:
                 "is_main": index == 0,
             },
             "parts": [],
-            "steps": TrackedSteps(self.post.group(view), self.post),
+            "steps": self._tracked(view),
+            "routines": routines,
             "tools": tools,
             "frames": frames,
             "vendor": self.post.context_values(view),
@@ -283,6 +293,9 @@ class _Renderer:
             "options": self.manifest.options,
             "post": {"name": self.manifest.name, "vendor": self.manifest.vendor},
         }
+
+    def _tracked(self, steps: Sequence[Any]) -> TrackedSteps:
+        return TrackedSteps(self.post.group(steps), self.post)
 
     def _files(
         self,
