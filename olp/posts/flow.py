@@ -77,6 +77,24 @@ class RoutineSteps:
     steps: Sequence[Any]
 
 
+def routine_statements(routines: Sequence[RoutineSteps]) -> list[PostStep]:
+    """The steps of ``routines``, each routine's parameters (of a known type) and local
+    declarations first as ``declare`` steps (index -1): what a post's ``context_values``
+    needs to know of the names and types its routines use."""
+    out: list[PostStep] = []
+    for item in routines:
+        routine = item.routine
+        params = [
+            ir.Declare(name=p.name, type_name=p.type_name, dims=p.dims, span=p.span)
+            for p in routine.params
+            if p.type_name
+        ]
+        for decl in [*params, *routine.declarations]:
+            out.append(PostStep(-1, "declare", decl.span.location, decl))
+        out += [s for s in item.steps if isinstance(s, PostStep)]
+    return out
+
+
 def expansions(program: ir.Program) -> dict[str, list[tuple[ir.Expanded, int]]]:
     """Upper-case routine name -> every :class:`olp.ir.Expanded` of it in ``program`` (the
     analysis view) with the index of its first instruction, in program order."""

@@ -35,7 +35,9 @@ Template context (every file)
     :class:`~olp.posts.view.PostTool` / :class:`~olp.posts.view.PostFrame` with a legal unique
     name.
 ``vendor``
-    What the post's ``context_values`` returns for this file (ABB's custom speed and zone data).
+    What the post's ``context_values`` returns for this file (ABB's custom speed and zone data);
+    it is given the routines' statements too (their parameters and local declarations as
+    ``declare`` steps first).
 ``modal``
     A :class:`~olp.posts.view.Modal` change tracker: ``modal.changed("cdis", v)``; fresh for
     every file.
@@ -57,7 +59,7 @@ from olp.compiled import BlockRows, PathBlock, StepBlocks, items_of, pieces
 from olp.diagnostics import Diagnostic
 from olp.errors import PostError
 from olp.ir import is_motion
-from olp.posts.flow import RoutineSteps, weave, weave_routines
+from olp.posts.flow import RoutineSteps, routine_statements, weave, weave_routines
 from olp.posts.rows import PostRows
 from olp.posts.text import basename
 from olp.posts.view import (
@@ -268,8 +270,9 @@ class _Renderer:
             if self.post.writes_routines():
                 lines = self.post.comment_lines
                 routines = weave_routines(self.compiled.program, view, lines)
-                routines = [RoutineSteps(r.routine, self._tracked(r.steps)) for r in routines]
             view = weave(self.compiled.program, view)
+        vendor = self.post.context_values([*routine_statements(routines), *view])
+        routines = [RoutineSteps(r.routine, self._tracked(r.steps)) for r in routines]
         name = unit_name or self.name
         return {
             "program": {"name": name, "source": self.source, "main": self.name},
@@ -287,7 +290,7 @@ class _Renderer:
             "routines": routines,
             "tools": tools,
             "frames": frames,
-            "vendor": self.post.context_values(view),
+            "vendor": vendor,
             "station": self.compiled.station,
             "robot": self.compiled.station.robot,
             "options": self.manifest.options,

@@ -155,3 +155,46 @@ def test_one_configuration_at_every_call_is_written_once(station: Any) -> None:
     result = build(station, program)
     assert result.ok
     assert result.files["t.src"].count("DEF Turn()") == 1
+
+
+SCREW = ROUTINES / "screw_cell.src"
+
+
+@pytest.fixture(scope="module")
+def ur_station() -> Any:
+    return olp.load_station(REPO / "stations" / "ur5e_screw_cell.yaml")
+
+
+def test_urscript_writes_the_routines_as_functions(ur_station: Any) -> None:
+    result = build(ur_station, SCREW, "ur")
+    assert result.ok, [d.format() for d in result.diagnostics if d.severity == "error"]
+    golden("ur", result.files)
+    text = result.files["screw_cell.script"]
+    assert text.count("  def Shake(nTimes):") == 1 and text.count("  Shake(") == 2
+
+
+def test_urscript_refuses_an_out_parameter_the_routine_changes(station: Any) -> None:
+    """URScript passes by value: PlacePart's ``nCount:OUT`` (incremented) would silently stop
+    counting in the caller, so it is an error on the routine; Report's OUT parameter, only read,
+    is written (by value is exact there)."""
+    result = build(station, PALLETISE, "ur")
+    errors = [d for d in result.diagnostics if d.severity == "error" and d.kind == "flow"]
+    by_value = [d for d in errors if "passed by reference (OUT)" in d.message]
+    assert [(d.span.line, "nCount" in d.message) for d in by_value if d.span] == [(40, True)]
+    assert not result.files
+
+
+@pytest.mark.parametrize("post", ["abb", "fanuc"])
+def test_posts_without_routines_refuse_parameters_and_name_what_they_leave_out(
+    station: Any, post: str
+) -> None:
+    """RAPID and LS do not write routines yet: a routine's body at each call is exact only
+    without parameters, so PlacePart and Gripper are errors, and the functions and the handler
+    no call runs are warnings naming them (never a silent drop)."""
+    result = build(station, PALLETISE, post)
+    errors = [d for d in result.diagnostics if d.kind == "routine"]
+    assert sorted(d.span.line for d in errors if d.span) == [40, 51]
+    left_out = [d for d in result.diagnostics if d.kind == "routine_not_written"]
+    assert [d.severity for d in left_out] == ["warning"] * 3
+    assert sorted(d.span.line for d in left_out if d.span) == [57, 65, 70]
+    assert not result.files

@@ -1,7 +1,8 @@
 """KRL AST -> :class:`olp.ir.Program`: the statement walk, calls and loops.
 
 See :mod:`olp.frontends.krl` for what is lowered and the decisions behind it. In short: the first
-DEF is the program; calls of other DEFs of the module are inlined; FOR loops with constant
+DEF is the program; calls of other DEFs of the module are lowered at each call and kept as
+calls of routines (:mod:`olp.frontends.krl.routines`); FOR loops with constant
 bounds are unrolled; straight-line statements are lowered; other control flow is ignored when
 lowering it would change nothing, and rejected (naming the construct and its line) otherwise.
 """
