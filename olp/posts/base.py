@@ -266,9 +266,10 @@ class Post:
             out += self.check_instruction(item, compiled)
         out += self._acceleration_checks(compiled.steps)
         if compiled.program.routines and self.writes_routines():
-            from olp.posts.routines import routine_checks
+            from olp.posts.routines import once_per_statement, routine_checks
 
             out += routine_checks(compiled, self)
+            return once_per_statement([*out, *self.check_program(compiled)])
         return out + self.check_program(compiled)
 
     def check_block(self, block: PathBlock, compiled: CompiledProgram) -> list[Diagnostic]:

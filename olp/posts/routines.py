@@ -177,6 +177,19 @@ def _text(value: Any) -> str:
     return str(value)
 
 
+def once_per_statement(found: Sequence[Diagnostic]) -> list[Diagnostic]:
+    """``found`` with one diagnostic per statement and message: a routine written once says
+    what cannot be written once, not at each of its calls."""
+    seen: set[tuple[str, str, str, Any]] = set()
+    out = []
+    for diag in found:
+        key = (diag.severity, diag.kind, diag.message, diag.span)
+        if key not in seen:
+            seen.add(key)
+            out.append(diag)
+    return out
+
+
 def flow_nodes_of_routines(program: ir.Program) -> list[Any]:
     """Every node of the program's routines (declarations, bodies, blocks included)."""
     out: list[Any] = []

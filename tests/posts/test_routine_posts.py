@@ -184,17 +184,52 @@ def test_urscript_refuses_an_out_parameter_the_routine_changes(station: Any) -> 
     assert not result.files
 
 
-@pytest.mark.parametrize("post", ["abb", "fanuc"])
-def test_posts_without_routines_refuse_parameters_and_name_what_they_leave_out(
-    station: Any, post: str
+def test_a_post_without_routines_refuses_parameters_and_names_what_it_leaves_out(
+    station: Any,
 ) -> None:
-    """RAPID and LS do not write routines yet: a routine's body at each call is exact only
-    without parameters, so PlacePart and Gripper are errors, and the functions and the handler
-    no call runs are warnings naming them (never a silent drop)."""
-    result = build(station, PALLETISE, post)
+    """LS does not write routines yet: a routine's body at each call is exact only without
+    parameters, so PlacePart and Gripper are errors, and the functions and the handler no call
+    runs are warnings naming them (never a silent drop)."""
+    result = build(station, PALLETISE, "fanuc")
     errors = [d for d in result.diagnostics if d.kind == "routine"]
     assert sorted(d.span.line for d in errors if d.span) == [40, 51]
     left_out = [d for d in result.diagnostics if d.kind == "routine_not_written"]
     assert [d.severity for d in left_out] == ["warning"] * 3
     assert sorted(d.span.line for d in left_out if d.span) == [57, 65, 70]
     assert not result.files
+
+
+SORT = ROUTINES / "sort_abb.src"
+
+
+@pytest.fixture(scope="module")
+def abb_station() -> Any:
+    return olp.load_station(REPO / "stations" / "abb_irb120_pick_cell.yaml")
+
+
+def test_rapid_writes_procs_and_funcs_with_inout(abb_station: Any) -> None:
+    """KRL's ``nCount:OUT`` is RAPID's ``INOUT num nCount`` (by reference), ``:IN`` a plain
+    parameter; a DEFFCT is a FUNC; the module passes the independent RAPID checker."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)
+        from rapidchecker.cli import check_file
+
+    result = build(abb_station, SORT, "abb")
+    assert result.ok, [d.format() for d in result.diagnostics if d.severity == "error"]
+    golden("abb", result.files)
+    text = result.files["sort_abb.mod"].replace("\r\n", "\n")
+    assert "  PROC Drop(num nBin, INOUT num nCount)" in text
+    assert "  FUNC bool Enough(num nHave)" in text
+    assert [str(e) for e in check_file(text)] == []
+
+
+def test_rapid_refuses_a_value_for_an_inout_parameter(abb_station: Any, tmp_path: Path) -> None:
+    source = SORT.read_text().replace("Drop(3, nSorted)", "Drop(3, 7)")
+    path = tmp_path / "sort_abb.src"
+    path.write_text(source)
+    result = build(abb_station, path, "abb")
+    (error,) = [d for d in result.diagnostics if d.severity == "error"]
+    assert error.span is not None and error.span.line == 11
+    assert "nCount of Drop is INOUT: the call must give it a variable" in error.message
