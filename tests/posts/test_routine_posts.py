@@ -233,3 +233,31 @@ def test_rapid_refuses_a_value_for_an_inout_parameter(abb_station: Any, tmp_path
     (error,) = [d for d in result.diagnostics if d.severity == "error"]
     assert error.span is not None and error.span.line == 11
     assert "nCount of Drop is INOUT: the call must give it a variable" in error.message
+
+
+CORPUS = REPO / "tests" / "corpus" / "krc" / "R1"
+CORPUS_FILES = sorted(p.name for p in (CORPUS / "Program").glob("*.src") if p.stem != "home_check")
+
+
+@pytest.mark.parametrize("name", CORPUS_FILES)
+def test_krl_to_krl_keeps_the_routines_of_the_corpus(
+    station: Any, name: str, tmp_path: Path
+) -> None:
+    """Every routine the KRL corpus's files hold comes back from the KRL post with the same
+    parameters, locals, result type and statements (the main body: test_krl_flow_post.py)."""
+    from olp.frontends.bundled import KrlOptions
+
+    config = CORPUS / "System" / "$config.dat"
+    path = CORPUS / "Program" / name
+    source = load_krl(path, config).program
+    result = olp.build(
+        station, path, post="kuka", program_options=KrlOptions(config_dat=config), collisions=None
+    )
+    assert result.ok, [d.format() for d in result.diagnostics if d.severity == "error"]
+    for file, text in result.files.items():
+        (tmp_path / file).write_text(text)
+    (written,) = [f for f in result.files if f.endswith(".src")]
+    again = load_krl(tmp_path / written).program
+    assert [signature(r) for r in again.routines] == [signature(r) for r in source.routines]
+    for ours, theirs in zip(again.routines, source.routines, strict=True):
+        assert shape(ours.body) == shape(theirs.body), ours.name
