@@ -41,6 +41,7 @@ def written_out(compiled: CompiledProgram, post: Post) -> tuple[CompiledProgram,
     found: list[Diagnostic] = []
     for routine in program.routines:
         found += _written_out_problems(routine, routine.name.upper() in sites, post)
+    found += _shared_names(program, sites, post)
     nodes = inline_expansions(program.instructions)
     flat = dataclasses.replace(program, instructions=nodes, routines=())
     return dataclasses.replace(compiled, program=flat), found
@@ -69,6 +70,29 @@ def _written_out_problems(routine: ir.Routine, called: bool, post: Post) -> list
         )
         return [Diagnostic("error", "routine", message, early.span)]
     return []
+
+
+def _shared_names(program: ir.Program, sites: Mapping[str, Any], post: Post) -> list[Diagnostic]:
+    """Errors for a local variable of a routine written out at its calls whose name another
+    routine or the program declares too: written out, one variable would stand for both."""
+    owners: dict[str, str] = {}
+    main = [n for n in leaves(inline_expansions(program.instructions)) if isinstance(n, ir.Declare)]
+    for decl in main:
+        owners.setdefault(decl.name.casefold(), "the program")
+    found = []
+    for routine in program.routines:
+        if routine.name.upper() not in sites:
+            continue
+        for decl in routine.declarations:
+            other = owners.setdefault(decl.name.casefold(), routine.name)
+            if other != routine.name:
+                message = (
+                    f"the {post.LANGUAGE} post does not write routines yet, and {routine.name}'s "
+                    f"variable {decl.name} would be the same variable as {other}'s once written "
+                    "out at its calls"
+                )
+                found.append(Diagnostic("error", "routine", message, decl.span))
+    return found
 
 
 def routine_checks(compiled: CompiledProgram, post: Post) -> list[Diagnostic]:

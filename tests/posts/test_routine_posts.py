@@ -261,3 +261,19 @@ def test_krl_to_krl_keeps_the_routines_of_the_corpus(
     assert [signature(r) for r in again.routines] == [signature(r) for r in source.routines]
     for ours, theirs in zip(again.routines, source.routines, strict=True):
         assert shape(ours.body) == shape(theirs.body), ours.name
+
+
+def test_written_out_locals_may_not_share_a_name(station: Any, tmp_path: Path) -> None:
+    """Written out at its call (LS), Tally's own ``n`` would be the program's ``n``: an error;
+    KRL keeps them apart, and so does the KUKA post, which writes the routine."""
+    source = (
+        "DEF p( )\nDECL INT n\nn = 5\nTally()\nWAIT SEC 1\nEND\n"
+        "DEF Tally( )\nDECL INT n\nn = 1\nEND\n"
+    )
+    path = tmp_path / "p.src"
+    path.write_text(source)
+    result = build(station, path, "fanuc")
+    (error,) = [d for d in result.diagnostics if d.kind == "routine"]
+    assert error.span is not None and error.span.line == 8
+    assert "same variable as the program's" in error.message
+    assert build(station, path, "kuka").ok
