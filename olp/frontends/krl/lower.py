@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
+import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -318,9 +319,29 @@ class _Lowering(Motions, Events):
         args = tuple(to_expr(arg, self._input_index) for arg in stmt.args)
         call = ir.RoutineCall(name=routine.name, args=args, span=stmt.span)
         body = build_instructions(lowered)
-        generic = self._generic_body(routine, stmt) if routine.params else None
+        generic = self._generic_body(routine, stmt) if self._reads_params(routine) else None
         pending = PendingCall(call=call, body=body, generic=generic, span=stmt.span)
         self.out.append(pending)  # type: ignore[arg-type]  # made a call by routines.assemble
+
+    def _reads_params(self, routine: Routine) -> bool:
+        """Whether a statement of ``routine`` other than a motion or a declaration names one of
+        its parameters (then its lowering with the parameters unknown may be the one text of
+        calls that differ; otherwise that lowering differs as the calls do and is not made:
+        it costs a second lowering of the body at each call). By the source text, so a name
+        in a comment counts too (it only costs time)."""
+        key = routine.name.upper()
+        found = self.ctx.reads_params.get(key)
+        if found is None:
+            words = [re.compile(rf"\b{re.escape(p.name)}\b", re.IGNORECASE) for p in routine.params]
+            skip = (MotionStmt, FastMotion, LinRows, Decl)
+            texts = (
+                self.sources.snippet(s.span)
+                for s in statements(routine.body)
+                if not isinstance(s, skip)
+            )
+            found = any(w.search(text) for text in texts for w in words)
+            self.ctx.reads_params[key] = found
+        return found
 
     def _generic_body(self, routine: Routine, stmt: CallStmt) -> tuple[ir.Node, ...] | None:
         """The routine lowered at this call with its parameters unknown (what its text says
