@@ -26,6 +26,7 @@ from olp.station.model import Station
 if TYPE_CHECKING:
     from olp.passes.pipeline import BuildOptions, Pass
     from olp.posts.base import Post
+    from olp.stream import StreamSummary
 
 
 def load_station(path: str | Path) -> Station:
@@ -74,7 +75,20 @@ def compile(
     ``passes``: another pipeline, e.g. with a pass of your own. ``collisions`` (None: no
     collision check) and ``other_times`` override the options' fields where given.
     """
-    from olp.passes.pipeline import PIPELINE, BuildOptions, run_passes
+    from olp.passes.pipeline import PIPELINE, run_passes
+
+    opts = _build_options(options, collisions)
+    if other_times is not None:
+        opts = dataclasses.replace(opts, other_times=other_times)
+    return run_passes(program, station, opts, PIPELINE if passes is None else passes)
+
+
+def _build_options(
+    options: BuildOptions | ResolveOptions | None, collisions: CollisionOptions | object | None
+) -> BuildOptions:
+    """``options`` as :class:`BuildOptions` (a bare ResolveOptions is its resolve part), with
+    ``collisions`` where given."""
+    from olp.passes.pipeline import BuildOptions
 
     if isinstance(options, ResolveOptions):
         options = BuildOptions(resolve=options)
@@ -82,20 +96,23 @@ def compile(
     if collisions is not _DEFAULT:
         assert collisions is None or isinstance(collisions, CollisionOptions)
         opts = dataclasses.replace(opts, collisions=collisions)
-    if other_times is not None:
-        opts = dataclasses.replace(opts, other_times=other_times)
-    return run_passes(program, station, opts, PIPELINE if passes is None else passes)
+    return opts
 
 
 @dataclass(frozen=True, slots=True)
 class BuildResult:
-    """What a build produced: the compiled program, rendered files and where they went."""
+    """What a build produced: the compiled program, rendered files and where they went.
+
+    A streamed build (:mod:`olp.stream`) holds no steps in ``compiled`` and no ``files`` (the
+    text went to disk window by window); ``streamed`` summarises it.
+    """
 
     compiled: CompiledProgram
     post: str
     diagnostics: tuple[Diagnostic, ...]
     files: Mapping[str, str] = field(default_factory=dict)
     written: tuple[Path, ...] = ()
+    streamed: StreamSummary | None = None
 
     @property
     def ok(self) -> bool:
@@ -113,6 +130,7 @@ def build(
     program_options: object | None = None,
     collisions: CollisionOptions | object | None = _DEFAULT,
     passes: tuple[Pass, ...] | None = None,
+    chunk_rows: int | None = None,
 ) -> BuildResult:
     """Compile ``program`` on ``station`` and render it through ``post``.
 
@@ -121,6 +139,9 @@ def build(
     the frontend's options for reading ``program`` when it is a file (see :func:`parse`; e.g.
     ``CsvOptions(frame="table")``, ``DslOptions(params={"SIDES": 6})``).
     Files are written to ``out_dir`` (if given) only when no error diagnostic remains.
+    ``chunk_rows``: a CSV toolpath written to ``out_dir`` through a post that streams is built
+    in windows of this many rows, in bounded memory (:mod:`olp.stream`); None: so from
+    :data:`olp.stream.STREAM_ROWS` rows on; 0: never.
     """
     from olp.posts import find_post
     from olp.posts.base import Post
@@ -132,6 +153,17 @@ def build(
         check_output_folder(out_dir)
     if not isinstance(station, Station):
         station = load_station(station)
+    writer = post if isinstance(post, Post) else find_post(post)
+    if not isinstance(program, Program) and out_dir is not None and passes is None:
+        from olp.stream import build_streamed, window_rows
+
+        opts = _build_options(options, collisions)
+        rows = window_rows(Path(program), writer, opts, chunk_rows)
+        if rows is not None:
+            csv_options = check_options(frontend_for(Path(program)), program_options, Path(program))
+            return build_streamed(
+                station, Path(program), writer, Path(out_dir), name, opts, csv_options, rows
+            )
     notes: tuple[Diagnostic, ...] = ()
     if not isinstance(program, Program):
         from olp import progress
@@ -141,7 +173,6 @@ def build(
         program, notes = parsed.program, parsed.notes
     elif program_options is not None:
         raise UsageError("program_options are for reading a program file, not an ir.Program")
-    writer = post if isinstance(post, Post) else find_post(post)
     compiled = compile(program, station, options, passes=passes, collisions=collisions)
     diagnostics = notes + compiled.diagnostics
     if not compiled.ok:

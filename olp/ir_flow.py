@@ -189,7 +189,21 @@ class Declare:
     """Declare variable ``name`` of ``type_name`` (the language's type name: ``INT``, ``REAL``,
     ``BOOL``, ``CHAR``, ``FRAME``, ``E6POS``, ``E6AXIS``, a structure's name) with array
     ``dims`` (empty for a scalar), an optional initial ``value``; ``constant``: it never
-    changes; ``exported``: visible to other modules (KRL ``GLOBAL``)."""
+    changes; ``exported``: visible to other modules (KRL ``GLOBAL``).
+
+    ``scope`` says where the variable lives:
+
+    * ``"routine"``: the routine's own variable (KRL ``DECL`` in a ``DEF``, RAPID routine data),
+      made afresh on every run;
+    * ``"module"``: the module's data (a KRL ``.dat`` data list): it keeps its value between
+      runs, and ``value`` is the value it holds when the program is loaded;
+    * ``"external"``: declared outside the program (another module's ``GLOBAL`` data, the
+      controller's ``$config.dat``) and only used here: a post for the same controller refers to
+      it without declaring it; ``value`` is None (it is not this program's to set).
+
+    ``elements``: the initial values of single array elements that module data sets after the
+    declaration (a KRL data list's ``aCount[2]=5``), as (indices, value) pairs in source order.
+    """
 
     name: str
     type_name: str
@@ -197,8 +211,18 @@ class Declare:
     value: Expr | None = None
     constant: bool = False
     exported: bool = False
+    scope: Literal["routine", "module", "external"] = "routine"
+    elements: tuple[tuple[tuple[Expr | None, ...], Expr], ...] = ()
     span: SourceSpan = GENERATED
     kind: Literal["declare"] = field(default="declare", init=False)
+
+    def __post_init__(self) -> None:
+        if self.scope not in ("routine", "module", "external"):
+            raise FlowError(f"Declare.scope must be routine, module or external: {self.scope!r}")
+        if self.scope == "external" and (self.value is not None or self.elements):
+            raise FlowError(f"Declare {self.name}: an external variable has no value here")
+        if self.elements and not self.dims:
+            raise FlowError(f"Declare {self.name}: elements are given for an array only")
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -36,8 +36,9 @@ import os
 import secrets
 import shutil
 import stat
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
+from typing import BinaryIO
 
 from olp.errors import UsageError
 
@@ -116,40 +117,132 @@ def _check_writable(folder: Path, what: str) -> None:
 def write_folder(files: Mapping[str, bytes], folder: str | Path) -> list[Path]:
     """Replace olp's files in ``folder`` by ``files`` (name -> bytes) as one set; see the
     module docstring. Returns the written paths, in the order of ``files``."""
-    target = Path(folder)
-    if target.is_symlink():
-        target = target.resolve()
     for name in files:
-        if name in ("", ".", "..", MANIFEST) or "/" in name or "\\" in name:
-            raise UsageError(f"output file name {name!r} is not a plain file name")
-    parent = target.parent
+        _check_name(name)
+    staged = StagedFolder(folder)
     try:
-        parent.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise UsageError(f"cannot create {parent}: {exc.strerror}") from exc
-    _remove_stale_staging(parent, target.name)
-    staging = _make_staging(parent, target.name)
-    try:
-        _fill(staging, target, files)
-        _swap_in(staging, target)
-    except OSError as exc:
-        shutil.rmtree(staging, ignore_errors=True)
-        raise UsageError(f"cannot write {target}: {exc.strerror or exc}") from exc
-    return [target / name for name in files]
+        for name, data in files.items():
+            staged.add(name, data)
+        return staged.commit()
+    finally:
+        staged.discard()
 
 
-def _fill(staging: Path, target: Path, files: Mapping[str, bytes]) -> None:
+def _check_name(name: str) -> None:
+    if name in ("", ".", "..", MANIFEST) or "/" in name or "\\" in name:
+        raise UsageError(f"output file name {name!r} is not a plain file name")
+
+
+class StagedFolder:
+    """A new set of output files built file by file (and each file piece by piece) in a
+    staging folder beside ``folder``, then swapped in as :func:`write_folder` does.
+
+    For output too big to hold in memory (a streamed build): :meth:`create` opens a new file
+    for writing in pieces, :meth:`scratch` a hidden working file that is never part of the set;
+    :meth:`commit` carries the user's own files over, writes the manifest and swaps the folders;
+    :meth:`discard` (always safe to call; a no-op after :meth:`commit`) removes the staging
+    folder, so that an error leaves the old output untouched and no half-written file.
+    """
+
+    def __init__(self, folder: str | Path) -> None:
+        target = Path(folder)
+        if target.is_symlink():
+            target = target.resolve()
+        self.target = target
+        parent = target.parent
+        try:
+            parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise UsageError(f"cannot create {parent}: {exc.strerror}") from exc
+        _remove_stale_staging(parent, target.name)
+        self.staging: Path | None = _make_staging(parent, target.name)
+        self.names: list[str] = []
+        self._scratch = 0
+
+    def create(self, name: str) -> BinaryIO:
+        """A new file ``name`` of the set, open for writing (flushed to disk by
+        :meth:`commit`)."""
+        self._claim(name)
+        return self._open(name)
+
+    def _claim(self, name: str) -> None:
+        _check_name(name)
+        if name in self.names:
+            raise UsageError(f"output file name {name!r} is written twice")
+        self.names.append(name)
+
+    def add(self, name: str, data: bytes) -> None:
+        """A new file ``name`` of the set holding ``data``, written and flushed at once."""
+        self._claim(name)
+        try:
+            _write_new(self._folder() / name, data)
+        except OSError as exc:
+            raise UsageError(f"cannot write {self.target}: {exc.strerror or exc}") from exc
+
+    def scratch(self) -> Path:
+        """A fresh hidden working file in the staging folder (not part of the set); the
+        caller removes it when done, or :meth:`discard` does."""
+        self._scratch += 1
+        path = self._folder() / f".scratch-{self._scratch}"
+        fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+        os.close(fd)
+        return path
+
+    def _folder(self) -> Path:
+        if self.staging is None:
+            raise UsageError(f"{self.target}: the staged output was already committed")
+        return self.staging
+
+    def _open(self, name: str) -> BinaryIO:
+        try:
+            fd = os.open(self._folder() / name, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+        except OSError as exc:
+            raise UsageError(f"cannot write {self.target / name}: {exc.strerror}") from exc
+        return os.fdopen(fd, "wb")
+
+    def commit(self) -> list[Path]:
+        """Swap the new set in; returns its paths in the order they were created."""
+        staging, target = self._folder(), self.target
+        try:
+            for entry in os.listdir(staging):
+                if entry.startswith(".scratch-"):
+                    os.unlink(staging / entry)
+            _fill(staging, target, self.names)
+            _swap_in(staging, target)
+        except OSError as exc:
+            raise UsageError(f"cannot write {target}: {exc.strerror or exc}") from exc
+        self.staging = None
+        return [target / name for name in self.names]
+
+    def discard(self) -> None:
+        """Remove the staging folder and everything in it (nothing after :meth:`commit`)."""
+        if self.staging is not None:
+            shutil.rmtree(self.staging, ignore_errors=True)
+            self.staging = None
+
+
+def _fill(staging: Path, target: Path, names: Sequence[str]) -> None:
+    """Complete a staging folder holding the new files ``names``: each flushed to disk, the
+    user's own files of ``target`` carried over, the manifest written."""
     ours = _previous_manifest(target)
     if target.is_dir():
         os.chmod(staging, stat.S_IMODE(target.stat().st_mode))
         for entry in sorted(os.listdir(target)):
-            if entry != MANIFEST and entry not in ours and entry not in files:
+            if entry != MANIFEST and entry not in ours and entry not in names:
                 _carry_over(target / entry, staging / entry)
-    for name, data in files.items():
-        _write_new(staging / name, data)
-    manifest = json.dumps({"files": sorted(files)}, indent=1) + "\n"
+    for name in names:
+        _fsync_file(staging / name)  # pieces written by StagedFolder.create
+    manifest = json.dumps({"files": sorted(names)}, indent=1) + "\n"
     _write_new(staging / MANIFEST, manifest.encode("utf-8"))
     _fsync_dir(staging)
+
+
+def _fsync_file(path: Path) -> None:
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
 
 
 def _previous_manifest(target: Path) -> set[str]:

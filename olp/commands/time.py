@@ -16,7 +16,9 @@ without ``--output``), with the residual of re-timing the recording with them
 A program with branches and loops is timed per path: the shortest and the longest path, with
 the branch choices that give each, or the path ``--assume`` names (inputs ``in3=true``,
 variables ``count=4``, loop passes ``loop:12=5``; :mod:`olp.passes.timing.branches`). The table
-per instruction and the trajectory follow the text, each instruction once.
+per instruction follows the text, each instruction once; ``--trajectory`` and ``--plot`` follow
+the path when every choice is decided (unrolled, :mod:`olp.passes.timing.unroll`), else the
+text, and say which on stderr.
 
 Exit codes as for ``olp build``: 0 timed, 1 the program has errors, 2 bad input.
 """
@@ -135,7 +137,7 @@ def run(args: argparse.Namespace) -> int:
     _print_results(compiled, args.quiet)
     if linear or joint:
         _print_sweep(compiled, linear, joint, options, args.quiet)
-    _write_outputs(compiled, args)
+    _write_outputs(compiled, args, options)
     return EXIT_OK
 
 
@@ -277,11 +279,17 @@ def _progress(done: int, total: int) -> None:
     print(f"\rtiming speeds {done}/{total}", end="", file=sys.stderr, flush=True)
 
 
-def _write_outputs(compiled: CompiledProgram, args: argparse.Namespace) -> None:
+def _write_outputs(
+    compiled: CompiledProgram, args: argparse.Namespace, options: BuildOptions
+) -> None:
     if not (args.trajectory or args.plot):
         return
     from olp.trajectory import instruction_starts, plot_trajectory, sample_program, write_csv
 
+    if compiled.paths is not None:
+        compiled, said = path_program(compiled, options)
+        if not args.quiet:
+            print(said, file=sys.stderr)
     sampled = sample_program(compiled, args.dt)
     writers: dict[str, Callable[[str], object]] = {
         "trajectory": lambda path: write_csv(sampled, path),
@@ -293,3 +301,31 @@ def _write_outputs(compiled: CompiledProgram, args: argparse.Namespace) -> None:
             write(path)
             if not args.quiet:
                 print(f"written: {path}")
+
+
+def path_program(compiled: CompiledProgram, options: BuildOptions) -> tuple[CompiledProgram, str]:
+    """The program a trajectory of ``compiled`` (with control flow) is sampled from: the path
+    every choice names, unrolled and compiled as a straight program
+    (:mod:`olp.passes.timing.unroll`), else the text; and a sentence that says which."""
+    import dataclasses
+
+    from olp.api import compile
+    from olp.passes.timing.conditions import Assumptions
+    from olp.passes.timing.unroll import unroll
+
+    text = "the trajectory follows the text, each instruction once: "
+    paths = compiled.paths
+    if paths is None or not paths.decided:
+        return compiled, text + "the program has open choices (name one path with --assume)"
+    unrolled = unroll(compiled.program, options.assume)
+    if unrolled.program is None:
+        return compiled, text + unrolled.reason
+    plain = dataclasses.replace(options, assume=Assumptions())
+    straight = compile(unrolled.program, compiled.station, plain)
+    if not straight.ok:
+        first = next(d for d in straight.diagnostics if d.severity == "error")
+        return compiled, text + f"the path's own run has errors ({first.message})"
+    return straight, (
+        f"the trajectory follows the path named: {len(straight.steps)} instructions, "
+        f"{straight.cycle_time:.3f} s"
+    )

@@ -197,6 +197,51 @@ def _lower(stream: CsvStream, name: str, station: Station | None) -> CsvResult:
     return CsvResult(program=builder.program(name), layout=stream.layout, ignored=stream.ignored)
 
 
+class CsvWindows:
+    """A CSV toolpath as a sequence of programs of at least ``rows`` rows each (whole blocks of
+    the reader), in file order: the first holds the joint move to the first row, the others
+    only linear moves; together they are the instructions :func:`load_csv` makes, in the same
+    nodes (the last row of the last window stops). Only one window's arrays are held at a time.
+
+    Use as a context manager; ``layout`` and ``ignored`` as in :class:`CsvResult`.
+    """
+
+    def __init__(
+        self,
+        path: str | os.PathLike[str],
+        options: CsvOptions | None,
+        station: Station | None,
+        rows: int,
+    ) -> None:
+        self.stream = open_csv(path, options)
+        self.layout = self.stream.layout
+        self.ignored = self.stream.ignored
+        self.name = Path(path).stem
+        self.rows = max(1, rows)
+        try:
+            self._builder = _ProgramBuilder(self.stream, self.stream.options, station)
+        except BaseException:
+            self.stream.close()
+            raise
+
+    def __enter__(self) -> CsvWindows:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.stream.close()
+
+    def __iter__(self) -> Iterator[ir.Program]:
+        builder, pending = self._builder, 0
+        for chunk in self.stream:
+            if pending >= self.rows:  # rows follow: the window is not the last one
+                yield builder.take(self.name)
+                pending = 0
+            builder.add(chunk)
+            pending += int(chunk.lines.size)
+            progress.advance(int(chunk.lines.size))
+        yield builder.program(self.name)
+
+
 def open_csv(path: str | os.PathLike[str], options: CsvOptions | None = None) -> CsvStream:
     """Open a CSV toolpath for streaming: ``.layout``, then iterate :class:`CsvChunk` arrays.
 
@@ -844,6 +889,7 @@ class _ProgramBuilder:
         self.frame = _frame(options.frame, station)
         self.zone = options.zone / 1000.0
         self.nodes: list[ir.Node] = []
+        self.started = False
         has_angles = len(self.layout.columns) >= 6
         if has_angles and options.orientation is not None:
             raise UsageError(
@@ -873,7 +919,8 @@ class _ProgramBuilder:
         speeds = self._speeds(chunk)
         labels = self._labels(chunk)
         lines, widths = chunk.lines, chunk.lengths
-        if not self.nodes:
+        if not self.started:
+            self.started = True
             self.nodes.append(self._first(poses[0], speeds[0], labels, lines[0], widths[0]))
             poses, speeds, lines, widths = poses[1:], speeds[1:], lines[1:], widths[1:]
             labels = None if labels is None else labels[1:]
@@ -936,6 +983,12 @@ class _ProgramBuilder:
             return None
         labels: IntArray = chunk.values[:, -1].astype(np.int64)
         return labels
+
+    def take(self, name: str) -> ir.Program:
+        """The nodes made so far as a program, and a fresh start for the next ones (rows
+        follow them: their last row keeps its zone)."""
+        nodes, self.nodes = self.nodes, []
+        return ir.Program(name=name, instructions=tuple(nodes), source=self.stream.filename)
 
     def program(self, name: str) -> ir.Program:
         """The program; the robot stops at the last row."""

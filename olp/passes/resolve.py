@@ -95,9 +95,14 @@ class ResolveOptions:
 
 
 def resolve(
-    program: Program, station: Station, options: ResolveOptions | None = None
+    program: Program,
+    station: Station,
+    options: ResolveOptions | None = None,
+    start: FloatArray | None = None,
 ) -> CompiledProgram:
     """Resolve every motion of ``program`` on ``station``; never raises on a bad program.
+    ``start`` (dof,) rad: the joints the robot stands at before the first motion (None: the
+    robot's home; a program streamed in pieces continues from the previous piece's last).
 
     A dense toolpath (:class:`~olp.ir.LinearPath`) is resolved in vectorised batches into
     :class:`~olp.compiled.PathBlock`\\ s; a row that fails is analysed alone and becomes an
@@ -105,7 +110,8 @@ def resolve(
     """
     opts = options or ResolveOptions()
     robot = station.robot
-    state = _State(q=robot.home.copy(), robot=robot, opts=opts)
+    start_joints = robot.home.copy() if start is None else np.array(start, dtype=np.float64)
+    state = _State(q=start_joints.copy(), robot=robot, opts=opts)
     items: list[Item] = []
     diags: list[Diagnostic] = []
     nodes = program.flat_nodes()  # control flow: each instruction once, in source order
@@ -141,7 +147,7 @@ def resolve(
     return CompiledProgram(
         program=program,
         station=station,
-        start_joints=robot.home.copy(),
+        start_joints=start_joints,
         steps=steps,
         diagnostics=tuple(diags),
     )
@@ -1142,5 +1148,5 @@ def _range(robot: Robot, joint: int) -> str:
 def resolve_pass(compiled: CompiledProgram, options: BuildOptions) -> CompiledProgram:
     """The resolve pass: every motion of ``compiled.program`` resolved on its station
     (:func:`resolve`, with ``options.resolve``); diagnostics of earlier passes are kept."""
-    resolved = resolve(compiled.program, compiled.station, options.resolve)
+    resolved = resolve(compiled.program, compiled.station, options.resolve, compiled.start_joints)
     return dataclasses.replace(resolved, diagnostics=compiled.diagnostics + resolved.diagnostics)

@@ -56,13 +56,15 @@ the confidence given:
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from olp import ir
+from olp.compiled import PathBlock, items_of
 from olp.diagnostics import Diagnostic
 from olp.errors import PostError
 from olp.ir_flow import leaves_and_blocks
@@ -77,14 +79,21 @@ from olp.posts.flow_text import (
 )
 from olp.posts.numbers import NumberFormat, Storage
 from olp.posts.rapid_flow import RapidWriter, counter_problems, reference_problems
+from olp.posts.rows import number_column
 from olp.posts.sandbox import SafeText
 from olp.posts.text import IDENTIFIER, NUMBER, ArgumentRule, NameRule, one_of
+from olp.posts.view import RowColumns
 from olp.vendors.abb import confdata, normalised_rounded, pose_to_robtarget
 
 if TYPE_CHECKING:
     from olp.compiled import CompiledProgram, Step
+    from olp.ir import Tool
     from olp.posts.rows import PostRows
     from olp.posts.view import Modal, PostFrame, PostStep, PostTool
+    from olp.span import SourceSpan
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.intp]
 
 QUATERNION_DECIMALS = 9
 """Quaternion components, as RobotStudio writes them; a 1e-9 component error is ~2e-9 rad."""
@@ -192,19 +201,34 @@ def speed_name(post: Post, speed: Any) -> str:
     ``v21_17`` (mm/s, ``_`` for the point) or ``v100_o30`` (with ``v_ori`` 30 deg/s)."""
     text = post.number("speed", float(speed.linear) * 1000.0)
     if speed.angular is None:
+        return speed_label(text, None)
+    return speed_label(text, post.number("speed", math.degrees(speed.angular)))
+
+
+def speed_label(text: str, ori: str | None) -> str:
+    """:func:`speed_name` from the TCP speed as written (mm/s) and the orientation speed as
+    written (deg/s, None: no limit)."""
+    if ori is None:
         predefined = PREDEFINED_SPEEDS.get(float(text)) if text != "?" else None
-        if predefined is not None:
-            return predefined
-        return "v" + text.replace(".", "_")
-    ori = post.number("speed", math.degrees(speed.angular))
+        return predefined or "v" + text.replace(".", "_")
     return f"v{text.replace('.', '_')}_o{ori.replace('.', '_')}"
 
 
 def speeddata(post: Post, speed: Any) -> str:
     """``[v_tcp, v_ori, v_leax, v_reax]`` of an :class:`olp.ir.Speed` (mm/s, deg/s)."""
-    v_ori = SPEED_DEFAULTS[0] if speed.angular is None else math.degrees(speed.angular)
-    values = [float(speed.linear) * 1000.0, v_ori, *SPEED_DEFAULTS[1:]]
+    values = speeddata_values(float(speed.linear), speed.angular)[0].tolist()
     return "[" + ",".join(post.number("speed", v) for v in values) + "]"
+
+
+def speeddata_values(linear: ArrayLike, angular: float | None) -> FloatArray:
+    """``[v_tcp, v_ori, v_leax, v_reax]`` (n, 4) (mm/s, deg/s) of path speeds (n,) m/s with
+    the orientation speed limit ``angular`` rad/s (None: :data:`SPEED_DEFAULTS`)."""
+    v = np.asarray(linear, dtype=np.float64).reshape(-1)
+    v_ori = SPEED_DEFAULTS[0] if angular is None else math.degrees(angular)
+    out = np.empty((v.size, 4))
+    out[:, 0] = v * 1000.0
+    out[:, 1:] = [v_ori, *SPEED_DEFAULTS[1:]]
+    return out
 
 
 def zone_name(post: Post, zone: Any) -> str:
@@ -212,7 +236,11 @@ def zone_name(post: Post, zone: Any) -> str:
     ``z12_5`` (radius in mm)."""
     if zone.is_fine:
         return "fine"
-    text = post.number("zone", float(zone.radius) * 1000.0)
+    return zone_label(post.number("zone", float(zone.radius) * 1000.0))
+
+
+def zone_label(text: str) -> str:
+    """:func:`zone_name` of a zone that is not fine, from its radius as written (mm)."""
     predefined = PREDEFINED_ZONES.get(float(text)) if text != "?" else None
     return predefined or "z" + text.replace(".", "_")
 
@@ -221,9 +249,14 @@ def zonedata(post: Post, zone: Any) -> str:
     """A custom zonedata ``[FALSE, r, 1.5r, 1.5r, 0.15r, 1.5r, 0.15r]`` for a radius r (mm):
     pzone_tcp, pzone_ori, pzone_eax (mm), zone_ori (deg), zone_leax (mm), zone_reax (deg).
     The ratios are those of the predefined z10 .. z200 (olp's choice for other radii)."""
-    r = float(zone.radius) * 1000.0
-    values = [r, 1.5 * r, 1.5 * r, 0.15 * r, 1.5 * r, 0.15 * r]
+    values = zonedata_values(float(zone.radius))[0].tolist()
     return "[FALSE," + ",".join(post.number("zone", v) for v in values) + "]"
+
+
+def zonedata_values(radius: ArrayLike) -> FloatArray:
+    """The numbers of :func:`zonedata` (n, 6) (mm, deg) of zone radii (n,) m."""
+    r = np.asarray(radius, dtype=np.float64).reshape(-1, 1) * 1000.0
+    return np.hstack([r, 1.5 * r, 1.5 * r, 0.15 * r, 1.5 * r, 0.15 * r])
 
 
 def rapid_tooldata(post: Post, tool: PostTool) -> str:
@@ -251,11 +284,13 @@ def rapid_signal(post: Post, index: int, pattern: str) -> str:
     return name
 
 
-def rapid_rows_data(post: Post, rows: PostRows) -> SafeText:
+def rapid_rows_data(post: Post, rows: PostRows | RowColumns) -> SafeText:
     """The robtarget declarations of a run of MoveL (:mod:`olp.posts.rows`), exactly as
     ``module.mod.j2`` writes each (``LOCAL CONST robtarget p12 := [..];``): positions and
     quaternions formatted as columns. Names are legal identifiers and numbers are checked, so
     the lines are :class:`~olp.posts.sandbox.SafeText`."""
+    if isinstance(rows, RowColumns):
+        return SafeText("\n".join(_robtarget_lines(post, rows)))
     steps = rows.steps
     trans, rot = pose_to_robtarget(rows.poses())
     xyz = post.number_column("position", trans, steps)
@@ -270,16 +305,30 @@ def rapid_rows_data(post: Post, rows: PostRows) -> SafeText:
     return SafeText("\n".join(lines))
 
 
-def rapid_rows(post: Post, rows: PostRows, modal: Modal | None = None) -> SafeText:
+def rapid_rows(post: Post, rows: PostRows | RowColumns, modal: Modal | None = None) -> SafeText:
     """The moves of a run of MoveL (:mod:`olp.posts.rows`), exactly as ``module.mod.j2``
     writes each: ``PathAccLim`` where the path acceleration changes (``modal``, the template's
     state; without it, where a set one changes within the run), then
     ``MoveL p12, v100, z10, tool\\WObj:=wobj;`` (speed and zone data names computed once per
-    distinct value)."""
+    distinct value). A toolpath's rows (:class:`~olp.posts.view.RowColumns`) are written as
+    columns, or row by row where one of their speed or zone numbers cannot be written (to
+    report it on each row as the templates do)."""
+    if isinstance(rows, RowColumns):
+        data = RowData.of(post, rows)
+        if data is not None:
+            return SafeText(_move_lines(post, rows, data, modal))
+        return _step_moves(post, [rows.at(k) for k in range(len(rows))], modal, rows)
+    return _step_moves(post, rows.steps, modal, rows)
+
+
+def _step_moves(
+    post: Post, steps: Sequence[PostStep], modal: Modal | None, rows: PostRows | RowColumns
+) -> SafeText:
+    """:func:`rapid_rows` of moves one by one."""
     names: dict[Any, str] = {}
     lines = []
     previous = None
-    for step in rows.steps:
+    for step in steps:
         post.current_step = step
         accel = step.speed.linear_acceleration
         if modal.changed("path_acc", accel) if modal is not None else accel not in (None, previous):
@@ -303,6 +352,110 @@ def path_acc_line(post: Post, accel: float | None) -> str:
         return "    PathAccLim FALSE, FALSE;"
     value = post.number("path_acc", accel)
     return f"    PathAccLim TRUE \\AccMax:={value}, TRUE \\DecelMax:={value};"
+
+
+# --------------------------------------------------------------------------------------------
+# A toolpath's rows as columns (:class:`~olp.posts.view.RowColumns`): no step per row
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class RowData:
+    """The speed and zone data of a toolpath's rows, spelled once per distinct value: for each
+    distinct speed in order of first use its speeddata name (:func:`speed_name`) and value
+    (:func:`speeddata`), ``speed_of`` (n,) the index of each row's; the same for zones
+    (:func:`zone_name`, :func:`zonedata`: ``""`` for ``fine``)."""
+
+    speed_names: list[str]
+    speed_values: list[str]
+    speed_of: IntArray
+    zone_names: list[str]
+    zone_values: list[str]
+    zone_of: IntArray
+
+    @classmethod
+    def of(cls, post: Post, rows: RowColumns) -> RowData | None:
+        """The data of ``rows``, or None where one of their numbers cannot be written (the
+        caller then goes row by row, to report it on each row as the templates do)."""
+        angular = rows.node.angular
+        speeds, speed_of = first_uses(rows.speeds)
+        speed_texts = _checked_texts(post, "speed", speeddata_values(speeds, angular))
+        radii, zone_of = first_uses(rows.zones)
+        zone_texts = _checked_texts(post, "zone", zonedata_values(radii))
+        if speed_texts is None or zone_texts is None:
+            return None
+        speed_names = [
+            speed_label(t[0], None if angular is None else t[1]) for t in speed_texts.tolist()
+        ]
+        zone_names = [
+            "fine" if r == 0.0 else zone_label(t[0])
+            for r, t in zip(radii.tolist(), zone_texts.tolist(), strict=True)
+        ]
+        return cls(
+            speed_names,
+            ["[" + ",".join(t) + "]" for t in speed_texts.tolist()],
+            speed_of,
+            zone_names,
+            [
+                "" if r == 0.0 else "[FALSE," + ",".join(t) + "]"
+                for r, t in zip(radii.tolist(), zone_texts.tolist(), strict=True)
+            ],
+            zone_of,
+        )
+
+
+def first_uses(values: ArrayLike) -> tuple[FloatArray, IntArray]:
+    """The distinct values (u,) of ``values`` (n,) in order of first use, and the index (n,) of
+    each value among them (``-0.0`` is ``0.0``, as ``==`` has it)."""
+    distinct, first, inverse = np.unique(
+        np.asarray(values, dtype=np.float64), return_index=True, return_inverse=True
+    )
+    order = np.argsort(first, kind="stable")
+    rank = np.empty_like(order)
+    rank[order] = np.arange(order.size)
+    return distinct[order], rank[inverse.reshape(-1)]
+
+
+def _checked_texts(post: Post, quantity: str, values: FloatArray) -> NDArray[np.str_] | None:
+    """``values`` (u, k) spelled in ``quantity``, or None when one cannot be written."""
+    texts, ok = number_column(values, post.NUMBERS[quantity])
+    return texts.reshape(values.shape) if ok else None
+
+
+def _robtarget_lines(post: Post, rows: RowColumns) -> list[str]:
+    """:func:`rapid_rows_data` of a toolpath's rows: the numbers spelled and checked as
+    columns (a value that cannot be written is an error on its own row)."""
+    trans, rot = pose_to_robtarget(rows.poses)
+    xyz = post.number_texts("position", trans, rows.at).tolist()
+    quaternions = normalised_rounded(rot, QUATERNION_DECIMALS)
+    quat = post.number_texts("quaternion", quaternions, rows.at).tolist()
+    conf = rows.column("confdata").tolist()
+    extax = ",".join([EXTERNAL_AXIS_UNUSED] * 6)
+    return [
+        f"  LOCAL CONST robtarget {name} := [[{','.join(p)}],[{','.join(q)}],"
+        f"[{c[0]},{c[1]},{c[2]},{c[3]}],[{extax}]];"
+        for name, p, q, c in zip(rows.names, xyz, quat, conf, strict=True)
+    ]
+
+
+def _move_lines(post: Post, rows: RowColumns, data: RowData, modal: Modal | None) -> str:
+    """:func:`rapid_rows` of a toolpath's rows, their speed and zone names from ``data``. The
+    rows share one path acceleration: ``PathAccLim`` goes before the first where it changes."""
+    post.current_step = rows
+    lines = []
+    accel = rows.node.acceleration
+    if modal.changed("path_acc", accel) if modal is not None else accel is not None:
+        lines.append(path_acc_line(post, accel))
+    frame = rows.frame_item.name
+    wobj = "" if frame == "wobj0" else "\\WObj:=" + frame
+    tail = f", {rows.tool_item.name}{wobj};"
+    speeds, zones = data.speed_names, data.zone_names
+    lines += [
+        f"    MoveL {name}, {speeds[s]}, {zones[z]}{tail}"
+        for name, s, z in zip(
+            rows.names, data.speed_of.tolist(), data.zone_of.tolist(), strict=True
+        )
+    ]
+    return "\n".join(lines)
 
 
 def _robtarget_filter(post: Post, joints: ArrayLike, robot: Any, pose: ArrayLike) -> str:
@@ -345,6 +498,7 @@ class AbbPost(Post):
     VENDOR = "abb"
     LANGUAGE = "RAPID"
     ROWS = True
+    COLUMNS = True
     NAME_RULE = NAME_RULE
     CALL_ARGUMENTS = ArgumentRule(
         one_of(NUMBER, r'"[^"\\\x00-\x1f\x7f-\x9f\u2028\u2029]{0,80}"', IDENTIFIER),
@@ -377,27 +531,25 @@ class AbbPost(Post):
 
     def step_values(self, robot: Any, joints: Any) -> list[Mapping[str, Any]]:
         """The confdata ``(cf1, cf4, cf6, cfx)`` of each motion's planned joints (N, 6)."""
-        try:
-            conf = confdata(robot, np.asarray(joints, dtype=np.float64))
-        except (TypeError, ValueError) as exc:
-            raise PostError(f"the RAPID post cannot describe robot {robot.name!r}: {exc}") from exc
+        conf = _confdata(robot, joints)
         return [{"confdata": tuple(int(v) for v in row)} for row in conf.tolist()]
 
-    def context_values(self, steps: Sequence[PostStep]) -> Mapping[str, Any]:
+    def step_columns(self, robot: Any, joints: Any) -> Mapping[str, Any]:
+        """:meth:`step_values` as columns: ``{"confdata": array (N, 4)}`` of ``[cf1, cf4, cf6,
+        cfx]`` per row."""
+        return {"confdata": _confdata(robot, joints)}
+
+    def context_values(self, steps: Sequence[PostStep | RowColumns]) -> Mapping[str, Any]:
         """The custom speeddata and zonedata one file's motions need, in order of first use:
-        ``{"speeds": [{name, value}], "zones": [{name, value}]}``."""
+        ``{"speeds": [{name, value}], "zones": [{name, value}]}`` (a toolpath's rows from
+        their columns, :class:`RowData`)."""
         speeds: dict[str, str] = {}
         zones: dict[str, str] = {}
         for step in steps:
-            if not step.motion:
-                continue
-            self.current_step = step
-            name = speed_name(self, step.speed)
-            if name not in PREDEFINED_NAMES:
-                speeds.setdefault(name, speeddata(self, step.speed))
-            zname = zone_name(self, step.zone)
-            if zname not in PREDEFINED_NAMES:
-                zones.setdefault(zname, zonedata(self, step.zone))
+            if isinstance(step, RowColumns):
+                self._row_data(step, speeds, zones)
+            elif step.motion:
+                self._motion_data(step, speeds, zones)
         self.current_step = None
         flow = self.flow = self.writer([s.instruction for s in steps if s.kind in FLOW_STEP_KINDS])
         flow.prepare(steps)
@@ -410,6 +562,36 @@ class AbbPost(Post):
             "routine_data": flow.declarations(exported=False, skip=own),
             "module_data": flow.declarations(exported=True),
         }
+
+    def _motion_data(self, step: PostStep, speeds: dict[str, str], zones: dict[str, str]) -> None:
+        """The custom speeddata and zonedata of one motion, added where new."""
+        self.current_step = step
+        name = speed_name(self, step.speed)
+        if name not in PREDEFINED_NAMES:
+            speeds.setdefault(name, speeddata(self, step.speed))
+        zname = zone_name(self, step.zone)
+        if zname not in PREDEFINED_NAMES:
+            zones.setdefault(zname, zonedata(self, step.zone))
+
+    def _row_data(self, rows: RowColumns, speeds: dict[str, str], zones: dict[str, str]) -> None:
+        """:meth:`_motion_data` of a toolpath's rows, from their distinct values; row by row
+        where a number cannot be written (reported on each row, as the steps would be)."""
+        data = RowData.of(self, rows)
+        if data is None:
+            for k in range(len(rows)):
+                self._motion_data(rows.at(k), speeds, zones)
+            return
+        for name, value in zip(data.speed_names, data.speed_values, strict=True):
+            if name not in PREDEFINED_NAMES:
+                speeds.setdefault(name, value)
+        for name, value in zip(data.zone_names, data.zone_values, strict=True):
+            if name not in PREDEFINED_NAMES:
+                zones.setdefault(name, value)
+
+    def check_rows(self, block: PathBlock, compiled: CompiledProgram) -> list[Diagnostic]:
+        """Nothing: :meth:`check_instruction` checks joint moves and I/O only, and a toolpath's
+        rows are linear moves."""
+        return []
 
     def check_instruction(self, step: Step, compiled: CompiledProgram) -> list[Diagnostic]:
         """* ``joint_speed`` (warning): RAPID has no joint speed as a fraction of the axes'
@@ -441,19 +623,36 @@ class AbbPost(Post):
         extra += [found for r in routines for found in writer.routine_problems(r, table)]
         out: list[Diagnostic] = flow_problems(nodes, writer, extra)
         loads: set[str] = set()
-        for step in compiled.steps:
-            ins: Any = step.instruction
-            if ins.kind not in ("joint", "linear", "circular") or step.skipped:
-                continue
-            tool = step.tool
+        for index, span, tool in _motion_tools(compiled):
             if tool is None or tool.pose is None or tool.name in loads:
                 continue
             if np.array_equal(tool.pose, np.eye(4)):
                 continue
             loads.add(tool.name)
             body = compiled.station.tool_bodies.get(tool.name)
-            out.append(_load_warning(step.index, ins, tool.name, body))
+            out.append(_load_warning(index, span, tool.name, body))
         return out
+
+
+def _confdata(robot: Any, joints: Any) -> IntArray:
+    """:func:`olp.vendors.abb.confdata` of joints (N, 6) rad, (N, 4); a robot it cannot
+    describe is a PostError."""
+    try:
+        return confdata(robot, np.asarray(joints, dtype=np.float64))
+    except (TypeError, ValueError) as exc:
+        raise PostError(f"the RAPID post cannot describe robot {robot.name!r}: {exc}") from exc
+
+
+def _motion_tools(compiled: CompiledProgram) -> Iterator[tuple[int, SourceSpan, Tool | None]]:
+    """Index, source span and tool of each written motion (a toolpath: its first row, as
+    its rows share one tool)."""
+    for item in items_of(compiled.steps):
+        if isinstance(item, PathBlock):
+            yield item.start, item.node.row_span(0), item.tool
+            continue
+        ins: Any = item.instruction
+        if ins.kind in ("joint", "linear", "circular") and not item.skipped:
+            yield item.index, ins.span, item.tool
 
 
 def _joint_speed_warning(post: Post, index: int, ins: Any) -> Diagnostic:
@@ -468,14 +667,14 @@ def _joint_speed_warning(post: Post, index: int, ins: Any) -> Diagnostic:
     )
 
 
-def _load_warning(index: int, ins: Any, name: str, body: Any) -> Diagnostic:
+def _load_warning(index: int, span: SourceSpan, name: str, body: Any) -> Diagnostic:
     mass = None if body is None else body.mass
     what = "no mass" if not mass else f"mass {mass:g} kg but no centre of gravity"
     return Diagnostic(
         "warning",
         "tool_load",
         f"tool {name!r}: the station gives {what}; its tooldata load is a placeholder",
-        ins.span,
+        span,
         index,
         hint="identify the load on the controller (LoadIdentify) or enter it before running",
     )

@@ -181,6 +181,10 @@ class Post:
     """Whether the row writer also takes a toolpath's rows as columns
     (:class:`~olp.posts.view.RowColumns`): a toolpath is then written without a step per row
     (:meth:`columns_enabled`)."""
+    STREAMS: ClassVar[bool] = False
+    """Whether a big toolpath may be written window by window (:mod:`olp.posts.stream`): the
+    templates write each rows item only through row writer filters applied to the item itself,
+    nothing between two rows items, and nothing else in a file is computed from its rows."""
 
     def __init__(self, manifest: PostManifest) -> None:
         self.manifest = manifest

@@ -583,6 +583,30 @@ def _flow_checks(post: Post, compiled: CompiledProgram) -> list[Diagnostic]:
             "for that type"
         )
         out.append(Diagnostic("warning", "declaration_dropped", msg, decl.span))
+    return out + module_data_notes(compiled.program.instructions, lowered)
+
+
+def module_data_notes(nodes: Sequence[Any], lowered: Any) -> list[Diagnostic]:
+    """``module_data`` (warning): one per module-data variable written to a register, whose
+    value LS does not set: the register must hold the data list's value before the first run."""
+    from olp import ir_flow
+    from olp.posts.kuka_flow import krl_expr
+
+    out = []
+    for node in ir_flow.leaves_and_blocks(nodes):
+        if not (isinstance(node, ir_flow.Declare) and node.scope == "module"):
+            continue
+        var = lowered.variables.get(node.name.upper())
+        if var is None:
+            continue
+        value = "" if node.value is None else f" = {krl_expr(node.value)}"
+        elements = " and its elements' values" if node.elements else ""
+        msg = (
+            f"{node.name}{value} is module data, kept from one run to the next; LS does not set "
+            f"{var.ref()} when the program loads: set it to the data list's value{elements} "
+            "on the controller before the first run"
+        )
+        out.append(Diagnostic("warning", "module_data", msg, node.span))
     return out
 
 

@@ -56,7 +56,12 @@ FOR/ENDFOR chapter of a FANUC operator manual, both as stored public pages; pinn
   ``position_registers`` (default ``[101, 200]`` and ``[51, 100]``: the upper halves of the 200
   R and 100 PR a controller has by default, medium confidence), an array taking consecutive
   registers; references carry the name as their comment, ``R[101:nCount]`` (exports). A
-  ``BOOL`` holds 1 (TRUE) or 0 (FALSE) and is tested as ``R[n]=1``. Position components are
+  ``BOOL`` holds 1 (TRUE) or 0 (FALSE) and is tested as ``R[n]=1``. Module data (a KRL
+  ``.dat`` variable) gets its register the same way but no assignment of its value: a register
+  keeps its value from one run to the next, as a data list does, so the register must hold the
+  data list's value before the first run (a warning names it,
+  :func:`olp.posts.fanuc.module_data_notes`); another module's variable is an error. Position
+  components are
   ``PR[n,j]``, j = 1..6 for X, Y, Z, W, P, R (a public cheat sheet; exports ``PR[1,3]=PR[1,3]``);
   KRL's A, B, C are Fanuc's R, P, W (both Rz(A)·Ry(B)·Rx(C), :mod:`olp.vendors.fanuc`), joint
   components A1..A6 are j = 1..6. Text variables (``CHAR``): string registers exist only on
@@ -187,6 +192,13 @@ class Registers:
         key = decl.name.upper()
         if key in self.variables:
             return self.variables[key]
+        if decl.scope == "external":
+            where = decl.span.file.replace("\\", "/").rsplit("/", 1)[-1]
+            raise Unwritable(
+                f"{decl.name} is declared in another module's data list ({where}:"
+                f"{decl.span.line}), which only a program for the same controller can refer to",
+                decl,
+            )
         type_name = decl.type_name.upper()
         kind = NUMERIC_TYPES.get(type_name) or POSITION_TYPES.get(type_name)
         if kind is None:
@@ -437,7 +449,9 @@ class Lowering:
 
     def _declare(self, decl: ir.Declare) -> list[str]:
         var = self.registers.declare(decl)
-        if var is None or decl.value is None:
+        if var is None or decl.scope == "module":
+            return []  # a register keeps its value, as a data list does: not set on every run
+        if decl.value is None:
             return []
         if var.position or var.size != 1:
             raise Unwritable(
@@ -1038,6 +1052,8 @@ class Lowered:
     problems: tuple[tuple[Any, str], ...]
     unwritten: tuple[ir.Declare, ...] = ()
     """Declarations of types LS has no register for (an error where the variable is used)."""
+    variables: Mapping[str, Variable] = field(default_factory=dict)
+    """The registers given to variables, by upper-case name."""
 
 
 def lower(
@@ -1067,4 +1083,4 @@ def lower(
         for decl in lowering.registers.skipped.values()
         if decl.type_name.upper() not in {*NUMERIC_TYPES, *POSITION_TYPES}
     )
-    return Lowered(tuple(lines), tuple(problems), unwritten)
+    return Lowered(tuple(lines), tuple(problems), unwritten, dict(lowering.registers.variables))

@@ -25,7 +25,7 @@ variable.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -81,7 +81,16 @@ class Variable:
 
 
 def variable_of(decl: ir.Declare) -> Variable:
-    """The :class:`Variable` a declaration makes; a type olp does not map is a FlowProblem."""
+    """The :class:`Variable` a declaration makes; a type olp does not map, and a variable of
+    another module (``scope="external"``: no other vendor's program can refer to it), are a
+    FlowProblem."""
+    if decl.scope == "external":
+        where = decl.span.file.replace("\\", "/").rsplit("/", 1)[-1]
+        raise FlowProblem(
+            f"{decl.name} is declared in another module's data list ({where}:{decl.span.line}), "
+            "which only a program for the same controller can refer to: declare it in the "
+            "program's own data to carry its value"
+        )
     kind = KRL_KINDS.get(decl.type_name.upper())
     if kind is None:
         raise FlowProblem(f"the type {decl.type_name} has no counterpart olp writes")
@@ -436,3 +445,57 @@ def flow_pad_filter(post: Any, step: Any) -> int:
     ordinary statement inside blocks (0 outside any, or in a file without control flow)."""
     flow = getattr(post, "flow", None)
     return 0 if flow is None else int(flow.pad())
+
+
+def initial_value(var: Variable) -> ir.Expr | None:
+    """The value a variable starts with: its declaration's, or for a single string of module
+    data the text the data list sets as a whole (KRL ``sMsg[]="Ready"``)."""
+    decl = var.declare
+    if var.kind == "string" and not var.dims:
+        for indices, value in reversed(decl.elements):
+            if all(i is None for i in indices):
+                return value
+    return decl.value
+
+
+def element_values(var: Variable, default: str, spell: Callable[[ir.Expr], str]) -> list[str]:
+    """The initial values of a one-dimensional array ``var`` of module data, one text per
+    element: ``default`` where the data list sets none, else the element's value (``spell``
+    writes it). A FlowProblem where the size or an index is not a whole-number constant."""
+    decl = var.declare
+    size = constant_int(var.dims[0]) if len(var.dims) == 1 else None
+    if size is None or size <= 0:
+        raise FlowProblem(f"the size of the array {decl.name} must be a whole-number constant")
+    out = [default] * size
+    for indices, value in decl.elements:
+        head, tail = indices[:1], indices[1:]  # a CHAR array's row: names[2,]="text"
+        whole = all(t is None for t in tail) and (not tail or var.kind == "string")
+        index = constant_int(head[0]) if head and whole else None
+        if index is None or not 1 <= index <= size:
+            raise FlowProblem(f"an element of {decl.name} set by the data list is not 1..{size}")
+        out[index - 1] = spell(value)
+    return out
+
+
+def assigned_module_data(nodes: Sequence[Any]) -> list[tuple[ir.Declare, Any]]:
+    """Each module-data declaration of ``nodes`` (``scope="module"``) that a statement assigns,
+    with the first such statement: the variables whose value a run leaves for the next."""
+    module = {
+        n.name.casefold(): n
+        for n in leaves_and_blocks(nodes)
+        if isinstance(n, ir.Declare) and n.scope == "module"
+    }
+    found: dict[str, tuple[ir.Declare, Any]] = {}
+    for node in leaves_and_blocks(nodes):
+        target = node.target if isinstance(node, ir.Assign) else None
+        if isinstance(node, ir.PathTrigger) and isinstance(node.action, ir.Assign):
+            target = node.action.target
+        names = [node.variable] if isinstance(node, ir.For) else []
+        while isinstance(target, ir.Member | ir.Index):
+            target = target.base
+        names += [target.name] if isinstance(target, ir.Name) else []
+        for name in names:
+            decl = module.get(name.casefold())
+            if decl is not None and name.casefold() not in found:
+                found[name.casefold()] = (decl, node)
+    return list(found.values())

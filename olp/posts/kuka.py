@@ -57,7 +57,7 @@ from numpy.typing import ArrayLike, NDArray
 from olp.diagnostics import Diagnostic
 from olp.errors import PostError
 from olp.ir import ArcOrientation, CartesianTarget
-from olp.ir_flow import FLOW_TYPES, leaves_and_blocks
+from olp.ir_flow import FLOW_TYPES, Declare, leaves_and_blocks
 from olp.posts.base import Filter, Post
 from olp.posts.kuka_flow import (
     EVENT_KINDS,
@@ -475,6 +475,7 @@ class KukaPost(Post):
     ARC_ANGLE = True
     ROWS = True
     COLUMNS = True
+    STREAMS = True
 
     def step_columns(self, robot: Any, joints: Any) -> Mapping[str, Any]:
         """:meth:`step_values` as arrays (N,)."""
@@ -518,7 +519,10 @@ class KukaPost(Post):
 
     def check_program(self, compiled: CompiledProgram) -> list[Diagnostic]:
         """* ``flow`` (error): a name or text of a control-flow statement or condition that
-        KRL cannot hold (:func:`olp.posts.kuka_flow.flow_problem`)."""
+        KRL cannot hold (:func:`olp.posts.kuka_flow.flow_problem`).
+        * ``module_data`` (error): module data or another module's names in a program, and a
+          template folder that does not declare ``module_data: true`` (a copy made before
+          olp placed declarations by scope would declare them all in the ``.src``)."""
         found = []
         program = compiled.program
         nodes = [*leaves_and_blocks(program.instructions), *flow_nodes_of_routines(program)]
@@ -533,6 +537,19 @@ class KukaPost(Post):
             if (problem := routine_problem(routine)) is not None:
                 message = f"routine {routine.name} cannot be written in KRL: {problem}"
                 found.append(Diagnostic("error", "flow", message, routine.span))
+        scoped = [
+            n
+            for n in leaves_and_blocks(compiled.program.instructions)
+            if isinstance(n, Declare) and n.scope != "routine"
+        ]
+        if scoped and not self.manifest.module_data:
+            message = (
+                f"{scoped[0].name} is {scoped[0].scope} data, and the template folder "
+                f"{self.manifest.folder.name} does not declare module_data: true (a copy made "
+                "before olp wrote module data into the .dat): copy the bundled templates' "
+                "declaration lines and declare it"
+            )
+            found.append(Diagnostic("error", "module_data", message, scoped[0].span))
         return found
 
 

@@ -20,6 +20,7 @@ from typing import Any
 
 from olp import ir
 from olp.ir_flow import sub_expressions
+from olp.posts.sandbox import SafeText, unsafe_character
 
 _BINARY = {
     "and": "AND",
@@ -80,12 +81,20 @@ def _constant(expr: ir.Constant) -> str:
 
 
 def krl_decl(step: Any) -> str:
-    """A :class:`olp.ir.Declare` (or a step holding one) as ``DECL TYPE name[dims]=value``."""
+    """A :class:`olp.ir.Declare` as ``DECL TYPE name[dims]=value``; module data (the ``.dat``)
+    also with the lines that set single array elements (``name[2]=5``) after it."""
     decl: ir.Declare = step if isinstance(step, ir.Declare) else step.instruction
     dims = f"[{','.join(krl_expr(d) for d in decl.dims)}]" if decl.dims else ""
     value = "" if decl.value is None else f"={krl_expr(decl.value)}"
     prefix = ("GLOBAL " if decl.exported else "") + ("CONST " if decl.constant else "")
-    return f"DECL {prefix}{decl.type_name} {decl.name}{dims}{value}"
+    lines = [f"DECL {prefix}{decl.type_name} {decl.name}{dims}{value}"]
+    for indices, element in decl.elements:
+        at = ",".join("" if i is None else krl_expr(i) for i in indices)
+        lines.append(f"{decl.name}[{at}]={krl_expr(element)}")
+    bad = next((c for line in lines if (c := unsafe_character(line)) is not None), None)
+    if bad is not None:  # flow_problem reports it first; never a line break from data
+        raise ValueError(f"declaration of {decl.name}: control character {bad!r}")
+    return SafeText("\n".join(lines))
 
 
 def krl_routine_head(routine: ir.Routine) -> str:
@@ -204,6 +213,8 @@ def _exprs(node: Any) -> list[Any]:
     found = [getattr(node, f, None) for f in fields] + list(getattr(node, "dims", ()))
     found += [b.condition for b in getattr(node, "branches", ())]
     found += [v for c in getattr(node, "cases", ()) for v in c.values]
+    if isinstance(node, ir.Declare):
+        found += [e for indices, value in node.elements for e in (*indices, value)]
     if isinstance(node, ir.InterruptDecl):
         found.append(node.handler)
     if isinstance(node, ir.RoutineCall):

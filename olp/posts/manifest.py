@@ -30,6 +30,10 @@ The manifest says::
     routines: true                    # the templates write the program's routines (default
                                       # false: a folder copied before olp wrote them gets each
                                       # routine's body written out at every call instead)
+    module_data: true                 # the templates place declarations by scope (module
+                                      # data in the data list, external names not declared);
+                                      # default false: a folder copied before, which a post
+                                      # that checks it refuses for a program with module data
     options: {...}                    # free-form: templates see them as `options`, and so does
                                       # the post class
 
@@ -73,6 +77,7 @@ class PostManifest:
     accelerations: bool = False
     flow: bool = False
     routines: bool = False
+    module_data: bool = False
 
 
 def load_manifest(folder: Path) -> PostManifest:
@@ -90,8 +95,8 @@ def load_manifest(folder: Path) -> PostManifest:
     frames_in = str(raw.get("frames_in", "world"))
     if frames_in not in FRAMES_IN:
         raise PostError(f"{path}: frames_in must be one of {', '.join(FRAMES_IN)}")
-    flags = ("rows", "accelerations", "flow", "routines")
-    rows, accelerations, flow, routines = (_flag(raw, key, path) for key in flags)
+    keys = ("rows", "accelerations", "flow", "module_data", "routines")
+    rows, accelerations, flow, module_data, routines = (_flag(raw, key, path) for key in keys)
     return PostManifest(
         name=str(raw.get("name", folder.name)),
         vendor=str(raw.get("vendor", "")),
@@ -107,6 +112,7 @@ def load_manifest(folder: Path) -> PostManifest:
         rows=rows,
         accelerations=accelerations,
         flow=flow,
+        module_data=module_data,
         routines=routines,
     )
 

@@ -58,8 +58,12 @@ Data
 Declarations are the entry routine's data (``VAR num n;`` at the top of ``PROC main()``), which
 RAPID initialises on every call as KRL initialises a routine's own variables; an exported
 (KRL ``GLOBAL``) declaration is module data, global. ``CONST`` for constants (a value is
-required), ``VAR`` otherwise; no ``PERS``: a declaration in the IR is a program variable, and a
-persistent would keep its value from one run to the next. Types (:data:`RAPID_TYPES`): bool,
+required), ``VAR`` otherwise; module data (a KRL ``.dat`` variable, which keeps its value
+from one run to the next) is a module ``PERS``, written with the data list's value (an array's
+elements as a list; RAPID's zero of the type where the list gives none, :data:`PERS_ZERO`).
+RAPID requires a persistent's value in its declaration (RAPID reference, PERS; as recalled).
+A variable of another module's data list is an error: the RAPID program cannot refer to it.
+Types (:data:`RAPID_TYPES`): bool,
 ``num`` for INT and REAL (RAPID's num is a 32-bit float, as KRL's REAL; INT values are exact up
 to 2^23 only, so a whole-number constant beyond :data:`NUM_EXACT_INT` is an error rather than
 ``dnum`` arithmetic mixed with ``num``), ``string`` for ``CHAR[n]`` (n at most
@@ -101,13 +105,19 @@ from olp.posts.flow_text import (
     Variable,
     constant_int,
     direct_exit,
+    element_values,
     exprs_of,
     for_problem,
+    initial_value,
     string_index,
     variable_of,
     walk,
 )
 from olp.posts.text import NameRule
+
+PERS_ZERO = {"bool": "FALSE", "int": "0", "real": "0", "string": '""'}
+"""The value a persistent of these kinds is written with where the data list gives none (KRL:
+not valid until assigned; a program that reads it first stops on the KUKA controller)."""
 
 RAPID_TYPES = {
     "bool": "bool",
@@ -186,7 +196,8 @@ class RapidWriter(FlowWriter):
         out = [
             self.declaration(var) + ";"
             for var in self.symbols.variables.values()
-            if var.declare.exported == exported and id(var.declare) not in skip
+            if (var.declare.exported or var.declare.scope == "module") == exported
+            and id(var.declare) not in skip
         ]
         if not exported:
             out += [f"VAR {RAPID_TYPES[kind]} {name};" for name, kind in self.helpers]
@@ -208,15 +219,35 @@ class RapidWriter(FlowWriter):
                 raise FlowProblem(f"the sizes of the array {decl.name} must be whole numbers")
             dims = "{" + ", ".join(str(s) for s in sizes) + "}"
         value = ""
-        if decl.value is not None:
+        start = initial_value(var)
+        if start is not None:
             if any(
                 isinstance(e, ir.Name | ir.FunctionCall | ir.DigitalInput | ir.Index)
-                for e in walk(decl.value)
+                for e in walk(start)
             ):
                 raise FlowProblem(f"the initial value of {decl.name} is not made of constants")
-            value = " := " + self.expr(decl.value)
+            value = " := " + self.expr(start)
         storage = "CONST" if decl.constant else "VAR"
+        if decl.scope == "module" and not decl.constant:
+            storage, value = "PERS", " := " + self._persistent_value(var, value[4:])
         return f"{storage} {rapid_type} {self.name(decl.name)}{dims}{value}"
+
+    def _persistent_value(self, var: Variable, value: str) -> str:
+        """A PERS needs its value written: the data list's, else RAPID's zero of the type."""
+        if var.dims:
+            if len(var.dims) > 1:
+                raise FlowProblem(f"{var.name} has {len(var.dims)} dimensions; olp writes lists")
+            return "[" + ", ".join(element_values(var, self._zero(var), self.expr)) + "]"
+        return value or self._zero(var)
+
+    def _zero(self, var: Variable) -> str:
+        zero = PERS_ZERO.get(var.kind)
+        if zero is None:
+            raise FlowProblem(
+                f"{var.name} is module data without a value; a RAPID PERS "
+                f"{RAPID_TYPES[var.kind]} needs one written, and olp does not make one up"
+            )
+        return zero
 
     # ---- expressions
 

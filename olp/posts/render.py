@@ -51,6 +51,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -263,7 +264,7 @@ class _Renderer:
         unit_name: str | None = None,
     ) -> dict[str, Any]:
         view: Sequence[Any] = self.view.unit_steps(steps, allocation)
-        tools, frames = _used(allocation, view)  # a routine's motions are among these
+        every = view  # a routine's motions are among these
         routines: list[RoutineSteps] = []
         if self.post.WRITES_FLOW and self.compiled.program.has_flow:
             # a program with control flow is rendered from steps only (Post.columns_enabled)
@@ -271,34 +272,10 @@ class _Renderer:
                 lines = self.post.comment_lines
                 routines = weave_routines(self.compiled.program, view, lines)
             view = weave(self.compiled.program, view)
-        vendor = self.post.context_values([*routine_statements(routines), *view])
-        routines = [RoutineSteps(r.routine, self._tracked(r.steps)) for r in routines]
-        name = unit_name or self.name
-        return {
-            "program": {"name": name, "source": self.source, "main": self.name},
-            "split": count > 0,
-            "unit": {
-                "name": name,
-                "routine": routine,
-                "index": index,
-                "count": count,
-                "is_part": index > 0,
-                "is_main": index == 0,
-            },
-            "parts": [],
-            "steps": self._tracked(view),
-            "routines": routines,
-            "tools": tools,
-            "frames": frames,
-            "vendor": vendor,
-            "station": self.compiled.station,
-            "robot": self.compiled.station.robot,
-            "options": self.manifest.options,
-            "post": {"name": self.manifest.name, "vendor": self.manifest.vendor},
-        }
-
-    def _tracked(self, steps: Sequence[Any]) -> TrackedSteps:
-        return TrackedSteps(self.post.group(steps), self.post)
+        unit = Unit(unit_name or self.name, self.name, self.source, index, count, routine)
+        return unit_context(
+            self.post, self.compiled.station, unit, allocation, view, routines, every
+        )
 
     def _files(
         self,
@@ -306,26 +283,92 @@ class _Renderer:
         context: dict[str, Any],
         clash: Any = frozenset(),
     ) -> dict[str, str]:
-        import jinja2
+        return render_templates(self.post, self.env, entries, context, clash)
 
-        files: dict[str, str] = {}
-        for template, pattern in entries:
-            context["modal"] = Modal()
-            self.post.current_step = None
-            try:
-                text = self.env.get_template(template).render(**context)
-            except jinja2.TemplateError as exc:
-                path = self.manifest.folder / template
-                where = self.post.current_step
-                at = f" (writing {where.source})" if where is not None else ""
-                raise PostError(
-                    f"{path}:{_template_line(exc, path)}: template error{at}: {exc}"
-                ) from exc
-            fname = pattern.format(name=context["program"]["name"])
-            if fname in files or fname in clash:
-                raise PostError(f"post {self.manifest.name!r} writes {fname} twice")
-            files[fname] = _line_endings(text, self.manifest.line_ending)
-        return files
+
+@dataclass(frozen=True, slots=True)
+class Unit:
+    """What a file's context says of its program: ``name`` (this file's program), ``main``
+    (the main program's name), ``source`` (escaped), ``index`` (0: the whole program or the
+    main, k: part k), ``count`` (parts; 0: not split) and the ``routine`` it defines."""
+
+    name: str
+    main: str
+    source: str
+    index: int
+    count: int
+    routine: str
+
+
+def unit_context(
+    post: Post,
+    station: Any,
+    unit: Unit,
+    allocation: Allocation,
+    view: Sequence[Any],
+    routines: Sequence[RoutineSteps] = (),
+    every: Sequence[Any] | None = None,
+) -> dict[str, Any]:
+    """The template context of one file whose steps are ``view`` (see the module text), with
+    the program's ``routines`` where the post writes them; ``every``: the file's steps before
+    weaving (a routine's motions among them), for its tools and frames."""
+    tools, frames = _used(allocation, view if every is None else every)
+    vendor = post.context_values([*routine_statements(routines), *view])
+    written = [RoutineSteps(r.routine, TrackedSteps(post.group(r.steps), post)) for r in routines]
+    return {
+        "program": {"name": unit.name, "source": unit.source, "main": unit.main},
+        "split": unit.count > 0,
+        "unit": {
+            "name": unit.name,
+            "routine": unit.routine,
+            "index": unit.index,
+            "count": unit.count,
+            "is_part": unit.index > 0,
+            "is_main": unit.index == 0,
+        },
+        "parts": [],
+        "steps": TrackedSteps(post.group(view), post),
+        "routines": written,
+        "tools": tools,
+        "frames": frames,
+        "vendor": vendor,
+        "station": station,
+        "robot": station.robot,
+        "options": post.manifest.options,
+        "post": {"name": post.manifest.name, "vendor": post.manifest.vendor},
+    }
+
+
+def render_templates(
+    post: Post,
+    env: Any,
+    entries: Sequence[tuple[str, str]],
+    context: dict[str, Any],
+    clash: Any = frozenset(),
+) -> dict[str, str]:
+    """Each template of ``entries`` (template, file name pattern) rendered in ``env`` with
+    ``context`` (a fresh :class:`~olp.posts.view.Modal` each), line endings made the post's:
+    ``{file name: text}``. A file name in ``clash`` or written twice is a PostError."""
+    import jinja2
+
+    manifest = post.manifest
+    files: dict[str, str] = {}
+    for template, pattern in entries:
+        context["modal"] = Modal()
+        post.current_step = None
+        try:
+            text = env.get_template(template).render(**context)
+        except jinja2.TemplateError as exc:
+            path = manifest.folder / template
+            where = post.current_step
+            at = f" (writing {where.source})" if where is not None else ""
+            line = _template_line(exc, path)
+            raise PostError(f"{path}:{line}: template error{at}: {exc}") from exc
+        fname = pattern.format(name=context["program"]["name"])
+        if fname in files or fname in clash:
+            raise PostError(f"post {manifest.name!r} writes {fname} twice")
+        files[fname] = line_endings(text, manifest.line_ending)
+    return files
 
 
 def _template_line(exc: Exception, path: Path) -> int | str:
@@ -365,6 +408,7 @@ def _everything(steps: Sequence[Step]) -> Sequence[Any]:
     return items_of(steps)
 
 
-def _line_endings(text: str, ending: str) -> str:
+def line_endings(text: str, ending: str) -> str:
+    """``text`` with every line's trailing blanks dropped and lines ended by ``ending``."""
     lines = text.replace("\r\n", "\n").split("\n")
     return ending.join(line.rstrip() for line in lines)

@@ -115,6 +115,11 @@ def _spelled(v: FloatArray, decimals: int, compact: bool) -> tuple[NDArray[np.st
         head, tail = np.divmod(whole, 10**decimals)
         if decimals <= _TABLE_DECIMALS:
             tails = _fractions(decimals)[tail]
+        elif decimals <= 2 * _TABLE_DECIMALS:
+            # the first five digits and the rest, each by table look-up (ABB's quaternions: 9)
+            rest = decimals - _TABLE_DECIMALS
+            high, low = np.divmod(tail, 10**rest)
+            tails = np.strings.add(_fractions(_TABLE_DECIMALS)[high], _digits(rest)[low])
         else:
             tails = np.strings.add(".", np.strings.zfill(tail.astype(np.str_), decimals))
         body = np.strings.add(_integers(head), tails)
@@ -175,6 +180,12 @@ def _small_integers() -> NDArray[np.str_]:
 def _fractions(decimals: int) -> NDArray[np.str_]:
     """``.000`` ... ``.999`` for ``decimals`` 3: the point and the digits of every fraction."""
     return np.array([f".{k:0{decimals}d}" for k in range(10**decimals)])
+
+
+@functools.cache
+def _digits(count: int) -> NDArray[np.str_]:
+    """``000`` ... ``999`` for ``count`` 3: every ``count``-digit string, zero-padded."""
+    return np.array([f"{k:0{count}d}" for k in range(10**count)])
 
 
 def _integers(values: NDArray[np.int64]) -> NDArray[np.str_]:

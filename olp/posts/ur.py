@@ -81,6 +81,7 @@ from olp.posts.base import Filter, Post
 from olp.posts.flow_text import (
     FLOW_STEP_KINDS,
     Symbols,
+    assigned_module_data,
     flow_lines_filter,
     flow_pad_filter,
     flow_problems,
@@ -406,13 +407,24 @@ class UrPost(Post):
         """``program_too_long`` (warning): more than :data:`MAX_MOTIONS` motions;
         ``arc_blend`` (error): blends at arcs the controller refuses (module docstring);
         ``flow`` (error): a control-flow statement or declaration URScript cannot hold
-        exactly (:mod:`olp.posts.ur_flow`)."""
+        exactly (:mod:`olp.posts.ur_flow`); ``module_data`` (warning): module data the program
+        assigns, whose value a URScript run does not keep for the next."""
         nodes = compiled.program.instructions
         routines = compiled.program.routines
         own = [n for r in routines for n in (*_param_declarations(r), *r.declarations)]
         writer = self.writer([*own, *nodes])
         extra = [found for r in routines for found in writer.routine_problems(r)]
         found = flow_problems(nodes, writer, extra) + arc_blends(compiled)
+        found += [
+            Diagnostic(
+                "warning",
+                "module_data",
+                f"{decl.name} is module data, which the source controller keeps from one run "
+                "to the next; URScript starts it from its declared value on every run",
+                node.span,
+            )
+            for decl, node in assigned_module_data(nodes)
+        ]
         motions = sum(1 for s in compiled.steps if s.joints is not None)
         if motions <= MAX_MOTIONS:
             return found

@@ -55,7 +55,11 @@ declaration's own or, per type (olp's choice, the value KRL-like languages start
 of them (``[0, 0, 0]``). Poses and joint positions are errors: KRL gives them in mm and degrees
 with Euler angles, URScript in metres and a rotation vector, and olp does not convert a
 variable's value. KRL arrays count from 1, URScript lists from 0: ``a[i]`` is written
-``a[i - 1]`` (a constant index is written already shifted).
+``a[i - 1]`` (a constant index is written already shifted). Module data (a KRL ``.dat``
+variable) is ``global`` with the data list's value (an array's elements in its list); it starts
+from that value on every run, where the KUKA controller keeps the last run's: the post warns
+for each one the program assigns (:meth:`olp.posts.ur.UrPost.check_program`). A variable of
+another module's data list is an error.
 
 Expressions
 -----------
@@ -91,8 +95,10 @@ from olp.posts.flow_text import (
     Symbols,
     Variable,
     constant_int,
+    element_values,
     exprs_of,
     for_problem,
+    initial_value,
     string_index,
     variable_of,
     walk,
@@ -149,21 +155,23 @@ class UrWriter(FlowWriter):
             )
         if len(var.dims) > 1:
             raise FlowProblem(f"{decl.name} has {len(var.dims)} dimensions; olp writes lists")
-        if decl.value is not None:
+        start = initial_value(var)
+        if start is not None:
             if any(
                 isinstance(e, ir.Name | ir.FunctionCall | ir.DigitalInput | ir.Index)
-                for e in walk(decl.value)
+                for e in walk(start)
             ):
                 raise FlowProblem(f"the initial value of {decl.name} is not made of constants")
-            value = self.expr(decl.value)
+            value = self.expr(start)
         else:
             value = INITIAL[var.kind]
         if var.dims:
             size = constant_int(var.dims[0])
             if size is None or not 0 < size <= MAX_LIST:
                 raise FlowProblem(f"the size of the list {decl.name} must be 1 .. {MAX_LIST}")
-            value = "[" + ", ".join([value] * size) + "]"
-        scope = "global" if decl.exported else "local"
+            values = element_values(var, value, self.expr) if decl.elements else [value] * size
+            value = "[" + ", ".join(values) + "]"
+        scope = "global" if decl.exported or decl.scope == "module" else "local"
         return f"{scope} {self.name(decl.name)} = {value}"
 
     # ---- expressions

@@ -273,7 +273,7 @@ class RowColumns:
         return self.node.zones[self.piece.lo : self.piece.hi]
 
     def column(self, key: str) -> NDArray[Any]:
-        """The post's per-row value ``key`` (``vendor[key]`` of a step), (n,)."""
+        """The post's per-row value ``key`` (``vendor[key]`` of a step), (n,) or (n, k)."""
         values: NDArray[Any] = self.motions.columns[key]
         return values[self.piece.lo : self.piece.hi]
 
@@ -300,12 +300,18 @@ class RowColumns:
             frame_pose=motions.frame_pose,
             base_pose=motions.frame_pose @ pose,
             duration=0.0 if block.durations is None else float(block.durations[row]),
-            vendor={key: v[row].item() for key, v in motions.columns.items()},
+            vendor={key: _row_value(v[row]) for key, v in motions.columns.items()},
             new_tool=self.new_tool and k == 0,
             new_frame=self.new_frame and k == 0,
             new_zone=bool(self.new_zone[k]),
             new_linear_speed=bool(self.new_linear_speed[k]),
         )
+
+
+def _row_value(value: NDArray[Any]) -> Any:
+    """One row of a post's column as :meth:`ViewHooks.step_values` gives it: a Python scalar,
+    or a tuple of them for a column of several values per row (ABB's confdata, (n, 4))."""
+    return value.item() if value.ndim == 0 else tuple(value.tolist())
 
 
 @dataclass(frozen=True, slots=True)

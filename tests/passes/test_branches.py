@@ -200,7 +200,11 @@ def test_a_constant_declaration_decides_like_an_assumption(station: Station) -> 
     assert ends(paths)[0] == pytest.approx(straight(station, start(), lin(4, -350)), rel=TOL)
     assigned = ir.Assign(target=ir.Name(name="MODE"), value=ir.Constant(value=2))
     changed = paths_of(station, program(declared, start(), assigned, switch))
-    assert not changed.decided  # assigned somewhere: olp does not follow it, both stay open
+    assert changed.decided  # the assignment on the way decides it (CASE 1 no longer)
+    assert ends(changed)[0] == pytest.approx(straight(station, start(), lin(8, -100)), rel=TOL)
+    maybe = ir.If(branches=(ir.Branch(condition=IN1, body=(assigned,)),), span=span(2))
+    open_ = paths_of(station, program(declared, start(), maybe, switch))
+    assert not open_.decided  # assigned on one path only: both cases stay open
 
 
 def test_nested_blocks_count_choices_per_pass(station: Station) -> None:

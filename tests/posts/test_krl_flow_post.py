@@ -54,7 +54,7 @@ def test_krl_to_krl_keeps_every_statement(station: object, name: str, tmp_path: 
     for file, text in result.files.items():
         (tmp_path / file).write_text(text)
     (written,) = [f for f in result.files if f.endswith(".src")]
-    again = load_krl(tmp_path / written).program
+    again = load_krl(tmp_path / written, CONFIG).program  # the same controller's data
     assert shape(again) == shape(source)
     assert declared(again) == declared(source)
     assert len(list(again.motions())) == len(list(source.motions()))

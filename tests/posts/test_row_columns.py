@@ -22,7 +22,7 @@ from olp.posts.rows import number_column, spell_column
 
 REPO = Path(__file__).resolve().parents[2]
 CELL = REPO / "stations" / "kr6_milling_cell.yaml"
-COLUMN_POSTS = ["kuka"]  # posts whose row writer takes a toolpath as columns
+COLUMN_POSTS = ["kuka", "abb"]  # posts whose row writer takes a toolpath as columns
 
 EDGES = [0.0, -0.0, -0.0004, -0.0005, 0.0005, 0.00049999, 1e-320, -1e-320, 2.5, -2.5, 0.125]
 EDGES += [1e15, -1e17, 123456789.0125, 0.0015, 1.0005, 2.675, 1e300, -1e301, 0.5, -0.5, 9.9995]

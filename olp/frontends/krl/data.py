@@ -24,6 +24,7 @@ from olp.frontends.krl.ast import (
     Assign,
     DatBlock,
     Decl,
+    DeclItem,
     IgnoredLine,
     Index,
     Module,
@@ -79,6 +80,12 @@ class KrlData:
     public: bool = False
     declared_at: Mapping[str, ir.SourceSpan] = field(default_factory=dict)
     global_names: frozenset[str] = frozenset()
+    declarations: Mapping[str, tuple[Decl, DeclItem]] = field(default_factory=dict)
+    """Name (upper case) -> the declaration and its item, for the program's module data
+    (:mod:`olp.frontends.krl.module_data`)."""
+    elements: Mapping[str, tuple[Assign, ...]] = field(default_factory=dict)
+    """Name (upper case) -> the assignments of single elements of that array in the list
+    (``aCount[2]=5``), in order."""
 
     def names(self) -> tuple[str, ...]:
         """The declared names (upper case), in the order they were read."""
@@ -231,11 +238,23 @@ def _read_block(block: DatBlock, source: Source) -> KrlData:
     def store(name: str, value: Value) -> None:
         values[name] = value
 
+    declarations: dict[str, tuple[Decl, DeclItem]] = {}
+    elements: dict[str, tuple[Assign, ...]] = {}
     for stmt in block.body:
         if isinstance(stmt, Decl):
             names = [item.name.upper() for item in stmt.items]
             declared_at.update((n, item.span) for n, item in zip(names, stmt.items, strict=True))
+            pairs = zip(names, stmt.items, strict=True)
+            declarations.update((n, (stmt, item)) for n, item in pairs)
             global_names.update(names if stmt.is_global else ())
+        elif (
+            isinstance(stmt, Assign)
+            and stmt.target.name.upper() in declarations
+            and len(stmt.target.selectors) == 1
+            and isinstance(stmt.target.selectors[0], Index)
+        ):
+            name = stmt.target.name.upper()
+            elements[name] = (*elements.get(name, ()), stmt)
         elif isinstance(stmt, SignalDecl):
             declared_at[stmt.name] = stmt.span
             global_names.update([stmt.name] if stmt.is_global else [])
@@ -251,6 +270,8 @@ def _read_block(block: DatBlock, source: Source) -> KrlData:
         public=block.public,
         declared_at=declared_at,
         global_names=frozenset(global_names),
+        declarations=declarations,
+        elements=elements,
     )
 
 

@@ -48,6 +48,7 @@ from olp.frontends.krl.ast import (
 from olp.frontends.krl.data import OTHER_REASONS, KrlData, visible_globals
 from olp.frontends.krl.events import Events
 from olp.frontends.krl.flow import assigned_names, is_straight, jump_targets, statements, to_expr
+from olp.frontends.krl.module_data import with_module_data
 from olp.frontends.krl.motion import Motions
 from olp.frontends.krl.routines import PendingCall, assemble, moves
 from olp.frontends.krl.rows import build_instructions
@@ -810,6 +811,7 @@ def lower_module(
     program = ir.Program(
         name=name, instructions=assembled.instructions, source=src, routines=assembled.routines
     )
+    program = with_module_data(program, dat, config, shared)
     return KrlResult(
         program=program,
         ignored=tuple(ignored),

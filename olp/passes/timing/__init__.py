@@ -67,7 +67,11 @@ The model, point by point (each choice is what the estimate can be explained by)
   needs no IK and stays inside the joint limits (the box of limits is convex); its TCP curve
   deviates from a vendor's Cartesian blend by second-order terms in ``d``.
 * **Stops** — fine points stop. So do: a corner with ``d < 1 um`` (a move without TCP travel),
-  a tool change, and any instruction other than a comment between two moves. **PTP-LIN
+  a tool change, any instruction other than a comment between two moves, and a corner where
+  the path turns back (by more than 179.5°: the blend would fold onto itself). A chain whose
+  jerk-limited law had to be slowed for a sharp blend (a near-reversal, a tiny zone at a
+  corner) is timed again with those corners stopped, and the faster kept
+  (:mod:`~olp.passes.timing.corners`): a zone never costs more than the stop. **PTP-LIN
   blends are timed as stops** (a controller's switch from joint to path interpolation follows
   rules no vendor publishes): such a program's estimate is an upper bound (shown in the
   summary).
@@ -100,7 +104,8 @@ blend), :mod:`~olp.passes.timing.ptp` (Ruckig),
 :mod:`~olp.passes.timing.lines` (closed-form straight lines), :mod:`~olp.passes.timing.scurve`
 (the double S), :mod:`~olp.passes.timing.jerk` (jerk-limited chains),
 :mod:`~olp.passes.timing.geometry`
-(a chain's joint path and blends), :mod:`~olp.passes.timing.problem` and
+(a chain's joint path and blends), :mod:`~olp.passes.timing.corners` (corners timed as
+stops), :mod:`~olp.passes.timing.problem` and
 :mod:`~olp.passes.timing.chains` (path problems and their time laws),
 :mod:`~olp.passes.timing.reachability` (the numpy solver),
 :mod:`~olp.passes.timing.toppra_reference` (the toppra package, loaded only when asked for),

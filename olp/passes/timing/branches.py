@@ -19,9 +19,12 @@ pass's own timers (:func:`~olp.passes.timing.program.time_program`).
   values, constants); a branch whose condition is known false is never taken, the first one
   known true always. A choice that stays open gives the range: the shortest and the longest
   path over every open choice, each with the choices that give it.
+* **Values.** Conditions and bounds are folded with the values the program's own assignments
+  fix on every path to them (:mod:`.known`: ``n = 3`` before ``FOR i = 1 TO n``).
 * **Loops.** A ``FOR`` with bounds olp can fold runs its count; a loop named by ``--assume
-  loop:LINE=N`` (or ``loop:LABEL=N``) runs N passes; a ``WHILE`` whose condition is known
-  false none. Any other ``WHILE``, ``REPEAT`` or ``LOOP`` counts **one pass for both ends of
+  loop:LINE=N`` (or ``loop:LABEL=N``) runs N passes; a ``WHILE`` or ``REPEAT`` driven by a
+  counter the body steps runs the passes the counter gives; a ``WHILE`` whose condition is
+  known false none. Any other ``WHILE``, ``REPEAT`` or ``LOOP`` counts **one pass for both ends of
   the range**, and the result says which loops were counted so. An ``EXIT`` leaves its loop
   during any pass; an endless ``LOOP`` without one (a cell's main loop) is timed for its
   passes, i.e. one cycle.
@@ -61,6 +64,7 @@ from olp.passes.timing.conditions import (
     environment,
     expression_key,
 )
+from olp.passes.timing.known import Known
 from olp.span import SourceSpan
 
 if TYPE_CHECKING:
@@ -406,9 +410,9 @@ def motion_indices(program: ir.Program) -> NDArray[np.int64]:
 class _Walk:
     """One walk of the program's blocks with the states that reach each point."""
 
-    def __init__(self, timer: SegmentTimer, env: Environment, assumptions: Assumptions):
+    def __init__(self, timer: SegmentTimer, known: Known, assumptions: Assumptions):
         self.timer = timer
-        self.env = env
+        self.known = known
         self.assumptions = assumptions
         self.cursor = 0
         self.exits: list[States] = []
@@ -440,6 +444,7 @@ class _Walk:
                 states = {}
             else:
                 run.append(node)
+                self.known.learn(node)
             label = node.name if isinstance(node, ir.Label) else None
         return self.run(run, states)
 
@@ -459,8 +464,12 @@ class _Walk:
             return self.choose(node, states)
         if isinstance(node, ir.Expanded):
             return self.expanded(node, states)
-        passes, by_rule = self.passes(node, label)
+        counted = self.known.passes(node) if isinstance(node, ir.While | ir.Repeat) else None
+        self.known.enter_loop(node)
+        passes, by_rule = self.passes(node, label, counted)
+        entry = self.known.snapshot()
         out, completed = self.repeat(node, states, passes)
+        self.known.restore(entry)
         if by_rule and completed:  # a path ran the pass to its end: the count mattered
             self.notes[_key(node.span)] = (
                 f"{node.kind.upper()} at {_where(node.span)} counted as 1 pass (its count is not "
@@ -483,9 +492,12 @@ class _Walk:
     # ---- branches
 
     def choose(self, node: ir.If | ir.Switch, states: States) -> States:
-        arms = _if_arms(node, self.env) if isinstance(node, ir.If) else _case_arms(node, self.env)
+        env = self.known.environment()
+        arms = if_arms(node, env) if isinstance(node, ir.If) else case_arms(node, env)
+        self.known.evaluated(node)
         open_choice = sum(1 for _, taken in arms if taken) > 1
         out: States = {}
+        entry, ends = self.known.snapshot(), []
         for (text, taken), body in zip(arms, bodies(node), strict=True):
             if not taken or not states:
                 self.cursor += _size(body)
@@ -494,39 +506,26 @@ class _Walk:
             if open_choice:
                 choice = ((node.span.file, node.span.line, node.span.column, text), 1)
                 entering = {k: b.plus(0.0, (choice,)) for k, b in states.items()}
+            self.known.restore(entry)
             out = _merged(out, self.body(body, entering))
+            ends.append(self.known.snapshot())
+        self.known.restore(entry)
+        self.known.join(ends)
         return out
 
     # ---- loops
 
-    def passes(self, node: Any, label: str | None) -> tuple[int, bool]:
-        """How many passes loop ``node`` runs (see the module docstring), and whether that is
-        the rule for a count olp does not know."""
-        file = node.span.file.replace("\\", "/").rsplit("/", 1)[-1].casefold()
-        keys: list[LoopKey] = [(file, node.span.line), node.span.line]
-        keys += [label.casefold()] if label else []
-        for key in keys:
-            if key in self.assumptions.loops:
-                self.used_loops.add(key)
-                count = self.assumptions.loops[key]
-                if isinstance(node, ir.Repeat) and count < 1:
-                    where = f"the REPEAT at line {node.span.line}"
-                    raise UsageError(
-                        f"--assume loop:{_loop_text(key)}={count}: {where} runs at least once"
-                    )
-                return count, False
-        if isinstance(node, ir.For):
-            bounded = _for_count(node, self.env)
-            if bounded is not None:
-                return bounded, False
-        if isinstance(node, ir.While) and self.env.evaluate(node.condition) is False:
-            return 0, False
-        return 1, True
+    def passes(self, node: Any, label: str | None, counted: int | None) -> tuple[int, bool]:
+        """:func:`loop_passes` of ``node`` here."""
+        return loop_passes(
+            node, label, counted, self.assumptions, self.known.environment(), self.used_loops
+        )
 
     def repeat(self, node: Any, states: States, passes: int) -> tuple[States, bool]:
         """The states after ``passes`` passes of loop ``node`` (or an exit during one), and
         whether any path ran the last pass to its end."""
         start, size = self.cursor, _size(node.body)
+        entry = self.known.snapshot()
         exits: States = {}
         self.exits.append({})
         before: States | None = None
@@ -549,6 +548,7 @@ class _Walk:
                 )
                 break
             self.cursor, self.exits[-1] = start, {}
+            self.known.restore(entry)
             before, current = current, self.body(node.body, current)
             last_exits = self.exits[-1]
             exits = _merged(exits, last_exits)
@@ -559,7 +559,43 @@ class _Walk:
         return _merged(current, exits), bool(current) and passes > 0
 
 
-def _if_arms(node: ir.If, env: Environment) -> list[tuple[str, bool]]:
+def loop_passes(
+    node: Any,
+    label: str | None,
+    counted: int | None,
+    assumptions: Assumptions,
+    env: Environment,
+    used: set[LoopKey],
+) -> tuple[int, bool]:
+    """How many passes loop ``node`` runs (see the module docstring), and whether that is the
+    rule for a count olp does not know; ``label``: the label just before it; ``counted``: the
+    passes its counters give (:meth:`Known.passes`); an assumption that names it goes into
+    ``used``."""
+    file = node.span.file.replace("\\", "/").rsplit("/", 1)[-1].casefold()
+    keys: list[LoopKey] = [(file, node.span.line), node.span.line]
+    keys += [label.casefold()] if label else []
+    for key in keys:
+        if key in assumptions.loops:
+            used.add(key)
+            count = assumptions.loops[key]
+            if isinstance(node, ir.Repeat) and count < 1:
+                where = f"the REPEAT at line {node.span.line}"
+                raise UsageError(
+                    f"--assume loop:{_loop_text(key)}={count}: {where} runs at least once"
+                )
+            return count, False
+    if isinstance(node, ir.For):
+        bounded = _for_count(node, env)
+        if bounded is not None:
+            return bounded, False
+    if counted is not None:
+        return counted, False
+    if isinstance(node, ir.While) and env.evaluate(node.condition) is False:
+        return 0, False
+    return 1, True
+
+
+def if_arms(node: ir.If, env: Environment) -> list[tuple[str, bool]]:
     """(text, may run) per body of ``node`` (its branches, then its else)."""
     arms, decided = [], False
     for k, branch in enumerate(node.branches):
@@ -573,7 +609,7 @@ def _if_arms(node: ir.If, env: Environment) -> list[tuple[str, bool]]:
     return arms
 
 
-def _case_arms(node: ir.Switch, env: Environment) -> list[tuple[str, bool]]:
+def case_arms(node: ir.Switch, env: Environment) -> list[tuple[str, bool]]:
     subject = env.evaluate(node.subject)
     arms, decided = [], False
     for case in node.cases:
@@ -641,11 +677,15 @@ def path_times(
         )
         return PathTimes(None, None, given.given, reason=reason)
     env, timer = environment(program.instructions, given), SegmentTimer(compiled, options)
+
+    def known() -> Known:
+        return Known(env, program.instructions, given.names)
+
     timer.collecting = True  # a first walk notes every run to time, the second adds them up
-    _Walk(timer, env, given).all(program.instructions)
+    _Walk(timer, known(), given).all(program.instructions)
     timer.collecting = False
     timer.settle()
-    walk = _Walk(timer, env, given)
+    walk = _Walk(timer, known(), given)
     end = walk.all(program.instructions)
     _check_loops_used(walk, given)
     notes = [walk.notes[k] for k in sorted(walk.notes)]

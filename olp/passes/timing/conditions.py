@@ -15,8 +15,8 @@ Evaluation is constant folding over :mod:`olp.ir_flow` expressions: a name holds
 assumption says, or the value of a constant declaration, or the initial value of a variable
 that no statement assigns; everything else (a variable the program assigns, a function's
 result, a sensor) is :data:`UNKNOWN`, and so is any expression over it that its known parts do
-not decide (``false and x`` is false, ``true or x`` true). olp does not follow assignments
-along a path.
+not decide (``false and x`` is false, ``true or x`` true). What the program's own assignments
+fix along a path is added by the walk (:mod:`.known`).
 """
 
 from __future__ import annotations
@@ -213,7 +213,8 @@ class Environment:
 
 def environment(program_nodes: Iterable[Any], assumptions: Assumptions) -> Environment:
     """The environment of a program: ``assumptions`` over the values its declarations fix (a
-    constant, or a variable with an initial value that no statement assigns)."""
+    constant, or a variable with an initial value that no statement assigns and that no other
+    module can: not exported)."""
     nodes = list(f.leaves(program_nodes))
     assigned = {
         key
@@ -227,7 +228,12 @@ def environment(program_nodes: Iterable[Any], assumptions: Assumptions) -> Envir
     }
     fixed: dict[str, Value] = {}
     for n in nodes:
-        if isinstance(n, f.Declare) and not n.dims and n.name.casefold() not in assigned:
+        if (
+            isinstance(n, f.Declare)
+            and not n.dims
+            and (n.constant or not n.exported)  # another module may assign a GLOBAL one
+            and n.name.casefold() not in assigned
+        ):
             value = Environment({}, fixed).evaluate(n.value)
             if not isinstance(value, _Unknown):
                 fixed[n.name.casefold()] = value

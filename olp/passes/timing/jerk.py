@@ -27,8 +27,10 @@ a double S is a rectangle of speed filtered by two moving averages), and the res
 it is a jerk-limited law close to, not provably at, the jerk-limited optimum: the 1-D
 surrogate of step 2 takes the chain's peak speed and acceleration for all of it, and the
 uniform slow-down of step 4 slows a whole chain for one sharp corner (an upper bound there;
-measured in tests/passes/test_jerk.py). The TCP speed is not re-checked after averaging (it
-would take forward kinematics on every sample): the tests measure it.
+measured in tests/passes/test_jerk.py; where that costs more than stopping at the corner, the
+chain is timed with the corner stopped, :mod:`~olp.passes.timing.corners`). The TCP speed is
+not re-checked after averaging (it would take forward kinematics on every sample): the tests
+measure it.
 """
 
 from __future__ import annotations
@@ -131,13 +133,20 @@ def stretch(law: SmoothedTimeLaw, robot: Robot) -> float:
     smooth piece, and the tests sample it densely): ``max(1, v / v_max, sqrt(a / a_max))`` over
     those samples and joints. A uniform slow-down divides the path jerk too, so the jerk
     limit still holds."""
+    worst = max(1.0, float(np.max(limit_ratios(law, robot)[1], initial=0.0)))
+    return worst if worst > 1.0 + STRETCH_TOLERANCE else 1.0
+
+
+def limit_ratios(law: SmoothedTimeLaw, robot: Robot) -> tuple[FloatArray, FloatArray]:
+    """The averaged law's knots (T,) s (unstretched, :meth:`SmoothedTimeLaw.knots`) and the
+    factor (T,) by which it must be slowed at each for the joints' limits to hold there:
+    ``max(v / v_max, sqrt(a / a_max))`` over the joints, of the law as it is."""
     knots = law.knots()
     qd, qdd = law.rates(knots * law.stretch)
     limits = robot.limits
-    speed = float(np.max(np.abs(qd) / limits.velocity, initial=0.0))
-    accel = float(np.max(np.abs(qdd) / limits.acceleration, initial=0.0))
-    worst = max(1.0, speed, float(np.sqrt(accel)))
-    return worst if worst > 1.0 + STRETCH_TOLERANCE else 1.0
+    speed = np.max(np.abs(qd) / limits.velocity, axis=-1, initial=0.0)
+    accel = np.max(np.abs(qdd) / limits.acceleration, axis=-1, initial=0.0)
+    return knots, np.maximum(speed, np.sqrt(accel)) * law.stretch
 
 
 STRETCH_TOLERANCE = 1e-3

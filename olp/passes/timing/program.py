@@ -23,9 +23,10 @@ from olp.compiled import CompiledProgram, PathBlock, RowTrajectories, Step, item
 from olp.compiled import span_of as _span
 from olp.diagnostics import Diagnostic
 from olp.ir import is_motion
+from olp.passes.timing import corners as corner_rules
 from olp.passes.timing import jerk, ptp, ptp_blend, ur
 from olp.passes.timing.chains import PATH_SOLVERS, path_problem, time_law
-from olp.passes.timing.geometry import joined_geometry
+from olp.passes.timing.geometry import ChainGeometry, joined_geometry
 from olp.passes.timing.lines import LineProfiles, line_paths, line_profiles
 from olp.passes.timing.plan import (
     MIN_PATH_SPEED,
@@ -80,6 +81,8 @@ class Times:
         self.start = np.zeros(n)
         self.end = np.zeros(n)
         self.timed = np.zeros(n, dtype=bool)
+        # Blended corners timed as stops after all (olp.passes.timing.corners).
+        self.stopped = np.zeros(n, dtype=bool)
         self.objects: list[TimeLaw] = []
         self.lines: LineLaws | None = None
 
@@ -153,7 +156,7 @@ def time_program(
         steps=write_back(compiled, times),
         diagnostics=compiled.diagnostics
         + tuple(found)
-        + tuple(zone_stops(table, corners, joint_blends)),
+        + tuple(zone_stops(table, corners, joint_blends, times.stopped)),
     )
 
 
@@ -384,9 +387,43 @@ def time_chains(
             first = int(rows[0])
             found.append(Diagnostic("error", "timing", str(law), _span(steps, first), first))
             continue
-        _fill(out, rows, out.add_law(law), law.time_at(geometry.boundaries))
-        out.length[rows] = geometry.lengths
+        if not _split_if_faster(table, corners, rows, (geometry, law), options, out):
+            _fill(out, rows, out.add_law(law), law.time_at(geometry.boundaries))
+            out.length[rows] = geometry.lengths
     return found
+
+
+def _split_if_faster(
+    table: MotionTable,
+    corners: Plan,
+    rows: IntArray,
+    timed: tuple[ChainGeometry, PathTimeLaw | SmoothedTimeLaw],
+    options: TimingOptions,
+    out: Times,
+) -> bool:
+    """Time the chain ``rows`` again with its sharp corners stopped, if its jerk-limited law
+    had to be slowed for them (:mod:`~olp.passes.timing.corners`), and keep that in ``out`` if
+    it is faster; returns whether it was kept."""
+    geometry, law = timed
+    if not isinstance(law, SmoothedTimeLaw) or law.stretch <= 1.0 + corner_rules.SHARP_RATIO:
+        return False
+    stops = corner_rules.sharp_corners(law, geometry.boundaries, table.compiled.station.robot)
+    if stops.size == 0:
+        return False
+    pieces = corners.stopped_at(rows, rows[stops])
+    scratch = Times(table.size)
+    found = time_chains(table, pieces, np.arange(pieces.sizes.size), options, scratch)
+    if found or not np.all(scratch.timed[rows]):
+        return False
+    if float(np.sum(scratch.duration[rows])) >= law.duration:
+        return False
+    laws, mapped = np.unique(scratch.law[rows], return_inverse=True)
+    index = np.array([out.add_law(scratch.objects[int(k)]) for k in laws], dtype=np.int64)
+    out.law[rows] = index[mapped]
+    for name in ("start", "end", "duration", "length", "timed", "stopped"):
+        getattr(out, name)[rows] = getattr(scratch, name)[rows]
+    out.stopped[rows[stops]] = True
+    return True
 
 
 def solve_laws(
@@ -518,15 +555,22 @@ def _overflow(compiled: CompiledProgram, durations: FloatArray) -> list[Diagnost
 
 
 def zone_stops(
-    table: MotionTable, corners: Plan, joint_blends: FloatArray | None = None
+    table: MotionTable,
+    corners: Plan,
+    joint_blends: FloatArray | None = None,
+    stopped: NDArray[np.bool_] | None = None,
 ) -> list[Diagnostic]:
     """An info diagnostic for every zone that the model times as an exact stop although a
     motion follows (after the last motion the robot stops anyway); ``joint_blends`` (n,) m:
-    the joint moves' blends (:func:`~olp.passes.timing.ptp_blend.blended_joint_moves`)."""
+    the joint moves' blends (:func:`~olp.passes.timing.ptp_blend.blended_joint_moves`);
+    ``stopped`` (n,): blended corners the chain timer stopped after all
+    (:mod:`~olp.passes.timing.corners`)."""
     motions = np.flatnonzero(table.motion)
     if motions.size == 0:
         return []
     blended = corners.blend > 0
+    if stopped is not None:
+        blended &= ~stopped
     if joint_blends is not None:
         blended |= joint_blends > 0
     stops = (table.kind >= JOINT) & (table.zone > 0) & ~blended
@@ -542,7 +586,10 @@ def zone_stops(
     return found
 
 
-_PATH_STOP = "the next motion is not a path move with the same tool, or the corner is too short"
+_PATH_STOP = (
+    "the next motion is not a path move with the same tool, the corner is too short, or the "
+    "path turns back or too sharply to blend at speed"
+)
 
 
 _STOP_REASON = {

@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 
 from olp.compiled import CompiledProgram, PathBlock, Step, items_of
 from olp.ir import CircularMove, Comment, JointMove, LinearMove
+from olp.passes.timing import corners
 from olp.passes.timing.plan import MIN_BLEND_M, MIN_PATH_SPEED
 from olp.passes.timing.tcp import FK_ROWS
 from olp.station.model import Robot
@@ -248,11 +249,20 @@ class Plan:
         sizes: IntArray = np.diff(self.bounds)
         return sizes
 
+    def stopped_at(self, rows: IntArray, stops: IntArray) -> Plan:
+        """The plan of one chain ``rows`` (P,) cut into pieces at ``stops`` (rows among them
+        that now stop instead of blending into the next)."""
+        blend = self.blend.copy()
+        blend[stops] = 0.0
+        cut = np.flatnonzero(np.isin(rows[:-1], stops)) + 1
+        return Plan(blend, rows, np.concatenate([[0], cut, [rows.size]]).astype(np.int64))
+
 
 def plan(table: MotionTable, lengths: FloatArray) -> Plan:
     """The blends and chains of a program: a path move with a zone blends into the next motion
     (comments in between do not count) when that is a path move with the same tool, at
-    ``min(zone, L1 / 2, L2 / 2)`` of TCP travel if that is at least ``MIN_BLEND_M``."""
+    ``min(zone, L1 / 2, L2 / 2)`` of TCP travel if that is at least ``MIN_BLEND_M`` and the path
+    does not turn back there (:func:`turns_back`)."""
     n = table.size
     path = table.path
     moves = np.flatnonzero(table.kind != COMMENT)
@@ -263,10 +273,25 @@ def plan(table: MotionTable, lengths: FloatArray) -> Plan:
     with np.errstate(invalid="ignore"):
         d = np.minimum.reduce([table.zone, lengths / 2, lengths[after] / 2])
     blend = np.where(can & (d >= MIN_BLEND_M), d, 0.0)
+    blend[turns_back(table, np.flatnonzero(blend > 0), after)] = 0.0
     rows = np.flatnonzero(path)
     linked = (blend[rows[:-1]] > 0) & (nxt[rows[:-1]] == rows[1:])
     starts = np.flatnonzero(np.concatenate([[True], ~linked]))[: rows.size]  # none if no rows
     return Plan(blend, rows, np.append(starts, rows.size).astype(np.int64))
+
+
+def turns_back(table: MotionTable, rows: IntArray, after: IntArray) -> IntArray:
+    """The rows among ``rows`` whose TCP path turns back into the next motion ``after[rows]``
+    by more than :data:`~olp.passes.timing.corners.FOLD_TURN` (the blend would fold onto
+    itself)."""
+    if rows.size == 0:
+        return rows
+    robot = table.compiled.station.robot
+    angles = corners.turn_angles(
+        robot, table.q, table.tools[table.sample_tool], table.hi[rows], table.lo[after[rows]]
+    )
+    folded: IntArray = rows[angles > corners.FOLD_TURN]
+    return folded
 
 
 def below_floor(table: MotionTable, rows: IntArray) -> NDArray[np.bool_]:
