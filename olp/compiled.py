@@ -328,7 +328,10 @@ class CompiledProgram:
     @classmethod
     def start(cls, program: Program, station: Station) -> CompiledProgram:
         """``program`` before any pass: one empty step per instruction, starting at the
-        robot's home joints."""
+        robot's home joints. The program is taken with its calls expanded
+        (:meth:`olp.ir.Program.expanded`): an instruction of a routine has a step at every
+        call site."""
+        program = program.expanded()
         items: list[Item] = []
         index = 0
         for node in program.flat_nodes():

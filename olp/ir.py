@@ -38,6 +38,9 @@ from olp.ir_flow import (
 from olp.ir_flow import (
     INTERRUPT_ACTIONS as INTERRUPT_ACTIONS,
 )
+from olp.ir_flow import (
+    PARAMETER_DIRECTIONS as PARAMETER_DIRECTIONS,
+)
 
 # The statements beyond motion and I/O (control flow, data, kept source lines) live in
 # olp.ir_flow and are re-exported here, so that users import every IR node from olp.ir.
@@ -70,6 +73,9 @@ from olp.ir_flow import (
 )
 from olp.ir_flow import (
     Exit as Exit,
+)
+from olp.ir_flow import (
+    Expanded as Expanded,
 )
 from olp.ir_flow import (
     Expr as Expr,
@@ -111,6 +117,9 @@ from olp.ir_flow import (
     Name as Name,
 )
 from olp.ir_flow import (
+    Parameter as Parameter,
+)
+from olp.ir_flow import (
     PathTrigger as PathTrigger,
 )
 from olp.ir_flow import (
@@ -118,6 +127,12 @@ from olp.ir_flow import (
 )
 from olp.ir_flow import (
     Return as Return,
+)
+from olp.ir_flow import (
+    Routine as Routine,
+)
+from olp.ir_flow import (
+    RoutineCall as RoutineCall,
 )
 from olp.ir_flow import (
     Statement as Statement,
@@ -136,6 +151,12 @@ from olp.ir_flow import (
 )
 from olp.ir_flow import (
     While as While,
+)
+from olp.ir_flow import (
+    inline_expansions as inline_expansions,
+)
+from olp.ir_flow import (
+    leaves as leaves,
 )
 from olp.span import GENERATED, SourceSpan
 
@@ -736,18 +757,47 @@ class Program:
     """A named sequence of instructions read from ``source``.
 
     ``instructions`` holds the program's nodes: ordinary instructions and dense toolpaths
-    (:class:`LinearPath`). Iterating the program, ``len`` and the instruction indices that
-    diagnostics and reports give count every move of a toolpath as one instruction, as if the
-    program held ordinary moves only.
+    (:class:`LinearPath`); ``routines`` the program's own routines (:class:`Routine`), which
+    its :class:`RoutineCall`\\ s run (:meth:`expanded` is the program as checks see it).
+    Iterating the program, ``len`` and the instruction indices that diagnostics and reports
+    give count every move of a toolpath as one instruction, as if the program held ordinary
+    moves only; they walk the program's own body (a call is one instruction), while
+    :meth:`expanded` walks into each call.
     """
 
     name: str
     instructions: tuple[Node, ...]
     source: str = "<memory>"
+    routines: tuple[Routine, ...] = ()
 
     def __post_init__(self) -> None:
         if not isinstance(self.instructions, tuple):
             object.__setattr__(self, "instructions", tuple(self.instructions))
+        if not isinstance(self.routines, tuple):
+            object.__setattr__(self, "routines", tuple(self.routines))
+        seen: set[str] = set()
+        for routine in self.routines:
+            if not isinstance(routine, Routine):
+                raise IRError(f"Program.routines must hold Routine objects, got {routine!r}")
+            if routine.name.casefold() in seen:
+                raise IRError(f"Program {self.name}: routine {routine.name} is defined twice")
+            seen.add(routine.name.casefold())
+
+    def routine(self, name: str) -> Routine | None:
+        """The program's routine called ``name`` (any case), or None."""
+        wanted = name.casefold()
+        return next((r for r in self.routines if r.name.casefold() == wanted), None)
+
+    def expanded(self) -> Program:
+        """The analysis view: every :class:`RoutineCall` of one of the program's routines made
+        an :class:`Expanded` holding the routine's body (:func:`olp.ir_flow.expand_calls`), so
+        that iterating the program yields every instruction of a routine at each call site.
+        The routines are kept (a post writes them from here). Returns the program itself when
+        it holds no routine. Raises :class:`olp.ir_flow.FlowError` for recursion."""
+        if not self.routines:
+            return self
+        nodes = _flow.expand_calls(self.instructions, self.routines)
+        return dataclasses.replace(self, instructions=nodes)
 
     def __iter__(self) -> Iterator[Instruction]:
         for node in _flow.leaves(self.instructions):
@@ -762,8 +812,9 @@ class Program:
 
     @property
     def has_flow(self) -> bool:
-        """Whether the program holds control flow or data statements (:mod:`olp.ir_flow`)."""
-        return _flow.has_flow(self.instructions)
+        """Whether the program holds control flow or data statements (:mod:`olp.ir_flow`),
+        routines included."""
+        return bool(self.routines) or _flow.has_flow(self.instructions)
 
     def flat_nodes(self) -> tuple[Instruction | LinearPath, ...]:
         """The nodes in source order with blocks walked into: what the passes check, one step
@@ -791,13 +842,18 @@ class Program:
         a sequence of them (inserted in its place), or None (deleted). A toolpath's rows are
         instructions like any other (the copy holds them as ordinary moves; for a dense edit of
         a toolpath use :meth:`LinearPath.with_speeds` and friends). Blocks of control flow are
-        kept, with the instructions inside them edited the same way."""
+        kept, with the instructions inside them edited the same way, and so are the bodies of
+        the program's :attr:`routines` (a speed cap applies to their motions too)."""
 
         def one(node: Any) -> list[Any]:
             rows = list(node) if isinstance(node, LinearPath) else [node]
             return [new for row in rows for new in _as_list(edit(row))]
 
-        return self.replace_instructions(_flow.map_leaves(self.instructions, one))
+        routines = tuple(
+            dataclasses.replace(r, body=_flow.map_leaves(r.body, one)) for r in self.routines
+        )
+        nodes = _flow.map_leaves(self.instructions, one)
+        return dataclasses.replace(self, instructions=nodes, routines=routines)
 
     def map_motions(self, edit: Callable[[Motion], Edit]) -> Program:
         """:meth:`map` on the motions only; other instructions are kept as they are::

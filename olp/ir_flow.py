@@ -272,8 +272,10 @@ class Exit:
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Return:
-    """End the program here (olp inlines the routines it calls)."""
+    """Leave the routine here (in the program's own body: end the program); ``value``: what a
+    function (:attr:`Routine.returns`) gives back, None in a routine without a result."""
 
+    value: Expr | None = None
     span: SourceSpan = GENERATED
     kind: Literal["return"] = field(default="return", init=False)
 
@@ -397,6 +399,134 @@ def _finite(value: float) -> bool:
 
 
 # --------------------------------------------------------------------------------------------
+# Routines: definitions, parameters and calls
+#
+# A program holds its own routines in :attr:`olp.ir.Program.routines`; a :class:`RoutineCall`
+# in a body runs one of them. Checks and timing see a program with every call expanded
+# (:func:`expand_calls`: each call site holds the routine's body, so every motion inside a
+# routine is checked wherever it is called from).
+
+PARAMETER_DIRECTIONS = frozenset({"in", "out"})
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Parameter:
+    """A routine's parameter ``name`` of ``type_name`` (the language's type name, as
+    :class:`Declare` spells it; empty when the source does not say) with array ``dims``
+    (empty for a scalar; an extent left open is None).
+
+    ``direction``: ``"in"``, passed by value (the routine works on a copy; KRL ``:IN``);
+    ``"out"``, passed by reference (the routine reads the caller's variable and its changes are
+    the caller's: KRL ``:OUT``, and KRL's default when a parameter has no mark). A post that can
+    pass only by value must refuse an ``"out"`` parameter, never pass it by value silently.
+    """
+
+    name: str
+    type_name: str = ""
+    dims: tuple[Expr | None, ...] = ()
+    direction: str = "in"
+    span: SourceSpan = GENERATED
+
+    def __post_init__(self) -> None:
+        if not self.name:
+            raise FlowError("Parameter.name must not be empty")
+        if self.direction not in PARAMETER_DIRECTIONS:
+            raise FlowError(
+                f"Parameter.direction must be one of {sorted(PARAMETER_DIRECTIONS)}, "
+                f"got {self.direction!r}"
+            )
+        object.__setattr__(self, "dims", _tuple(self.dims))
+
+    @property
+    def by_reference(self) -> bool:
+        """Whether the caller's variable is passed (an ``"out"`` parameter)."""
+        return self.direction == "out"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Routine:
+    """A routine of the program: ``name``, ``params`` in call order, ``declarations`` (its
+    local variables and constants, each a :class:`Declare`), ``body`` (nodes, like a
+    program's), ``returns``: the type name of a function's result (KRL ``DEFFCT INT``; its
+    array extents in ``returns_dims``), None for a routine without one; ``exported``: other
+    modules may call it (KRL ``GLOBAL``).
+
+    A function gives its result with :class:`Return` ``(value=...)`` and is called in an
+    expression (:class:`FunctionCall`); a routine without a result is called with
+    :class:`RoutineCall`.
+    """
+
+    name: str
+    params: tuple[Parameter, ...] = ()
+    declarations: tuple[Declare, ...] = ()
+    body: tuple[Node, ...] = ()
+    returns: str | None = None
+    returns_dims: tuple[Expr | None, ...] = ()
+    exported: bool = False
+    span: SourceSpan = GENERATED
+    kind: Literal["routine"] = field(default="routine", init=False)
+
+    def __post_init__(self) -> None:
+        if not self.name:
+            raise FlowError("Routine.name must not be empty")
+        for name in ("params", "declarations", "body", "returns_dims"):
+            object.__setattr__(self, name, _tuple(getattr(self, name)))
+        if any(not isinstance(p, Parameter) for p in self.params):
+            raise FlowError(f"Routine {self.name}: params must be Parameter objects")
+        if any(not isinstance(d, Declare) for d in self.declarations):
+            raise FlowError(f"Routine {self.name}: declarations must be Declare statements")
+        names = [p.name.casefold() for p in self.params]
+        names += [d.name.casefold() for d in self.declarations]
+        twice = sorted({n for n in names if names.count(n) > 1})
+        if twice:
+            raise FlowError(f"Routine {self.name}: {twice[0]!r} is declared twice")
+
+    @property
+    def is_function(self) -> bool:
+        """Whether the routine gives a result (:attr:`returns`)."""
+        return self.returns is not None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class RoutineCall:
+    """Run routine ``name`` of the program (:attr:`olp.ir.Program.routines`) with ``args``,
+    one per parameter in order (None: an argument left out). An argument for an ``"out"``
+    parameter names the caller's variable (a :class:`Name`, :class:`Index` or
+    :class:`Member`). A call of a routine the program does not hold (another module's, the
+    controller's) is an :class:`olp.ir.Call`."""
+
+    name: str
+    args: tuple[Expr | None, ...] = ()
+    span: SourceSpan = GENERATED
+    kind: Literal["routine_call"] = field(default="routine_call", init=False)
+
+    def __post_init__(self) -> None:
+        if not self.name:
+            raise FlowError("RoutineCall.name must not be empty")
+        object.__setattr__(self, "args", _tuple(self.args))
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Expanded:
+    """A :class:`RoutineCall` with the body of the routine it runs, in the analysis view of a
+    program (:func:`expand_calls`); not a node of a program as a frontend or a user makes it.
+
+    Iterating a program walks into ``body`` as into any block, so that every instruction
+    inside a routine has a step of its own at every call site; the call itself is not an
+    instruction there (a post writes it as the call). A :class:`Return` in ``body`` ends the
+    expansion, and its labels are its own (a label in a routine is not one of the caller's).
+    """
+
+    call: RoutineCall
+    body: tuple[Node, ...]
+    span: SourceSpan = GENERATED
+    kind: Literal["expanded"] = field(default="expanded", init=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "body", _tuple(self.body))
+
+
+# --------------------------------------------------------------------------------------------
 # Blocks
 
 
@@ -515,7 +645,7 @@ class For:
         object.__setattr__(self, "body", _tuple(self.body))
 
 
-Block: TypeAlias = If | Switch | While | Repeat | Loop | For
+Block: TypeAlias = If | Switch | While | Repeat | Loop | For | Expanded
 Statement: TypeAlias = (
     Declare
     | Assign
@@ -527,9 +657,10 @@ Statement: TypeAlias = (
     | InterruptDecl
     | InterruptSwitch
     | PathTrigger
+    | RoutineCall
     | Verbatim
 )
-BLOCK_TYPES = (If, Switch, While, Repeat, Loop, For)
+BLOCK_TYPES = (If, Switch, While, Repeat, Loop, For, Expanded)
 FLOW_TYPES = (
     *BLOCK_TYPES,
     Declare,
@@ -542,6 +673,7 @@ FLOW_TYPES = (
     InterruptDecl,
     InterruptSwitch,
     PathTrigger,
+    RoutineCall,
 )
 """Nodes of this module that are not ordinary instructions (:class:`Verbatim` is one: passes
 and posts treat it like any other instruction)."""
@@ -630,3 +762,57 @@ def walk_expression(expr: Any) -> Iterator[Any]:
     yield expr
     for child in sub_expressions(expr):
         yield from walk_expression(child)
+
+
+# --------------------------------------------------------------------------------------------
+# The analysis view: calls expanded
+
+
+def expand_calls(nodes: Sequence[Any], routines: Sequence[Routine]) -> tuple[Any, ...]:
+    """``nodes`` with every :class:`RoutineCall` of one of ``routines`` (by name, any case)
+    made an :class:`Expanded` holding that routine's body, expanded the same way; calls of
+    other names are kept as they are.
+
+    Raises :class:`FlowError` for a routine that calls itself, directly or through others
+    (the chain and the call's place in the message): its expansion would never end.
+    """
+    table = {r.name.casefold(): r for r in routines}
+    return _expand(tuple(nodes), table, ())
+
+
+def _expand(
+    nodes: tuple[Any, ...], table: dict[str, Routine], chain: tuple[str, ...]
+) -> tuple[Any, ...]:
+    out: list[Any] = []
+    for node in nodes:
+        if isinstance(node, BLOCK_TYPES):
+            out.append(with_bodies(node, [_expand(b, table, chain) for b in bodies(node)]))
+            continue
+        routine = table.get(node.name.casefold()) if isinstance(node, RoutineCall) else None
+        if routine is None:
+            out.append(node)
+            continue
+        if routine.name.casefold() in chain:
+            names = " -> ".join([*chain, routine.name])
+            raise FlowError(
+                f"{node.span.location}: {routine.name} calls itself ({names}); its calls cannot "
+                "be expanded for checking"
+            )
+        body = _expand(routine.body, table, (*chain, routine.name.casefold()))
+        out.append(Expanded(call=node, body=body, span=node.span))
+    return tuple(out)
+
+
+def inline_expansions(nodes: Sequence[Any]) -> tuple[Any, ...]:
+    """``nodes`` with every :class:`Expanded` replaced by its body, in place: one body without
+    routines, for a writer that does not write them. Instructions keep their order (the step
+    of each stays its step)."""
+    out: list[Any] = []
+    for node in nodes:
+        if isinstance(node, Expanded):
+            out.extend(inline_expansions(node.body))
+        elif isinstance(node, BLOCK_TYPES):
+            out.append(with_bodies(node, [inline_expansions(b) for b in bodies(node)]))
+        else:
+            out.append(node)
+    return tuple(out)

@@ -40,6 +40,8 @@ class _Walk:
         self.labels = labels
         self.cursor = 0
         self.exits: list[set[int]] = []
+        self.returns: list[set[int]] = []
+        self.scope = ""  # labels of an expanded routine are its own: keyed by where it starts
         self.changed = False
 
     def body(self, nodes: Sequence[Any], before: frozenset[int]) -> frozenset[int]:
@@ -55,9 +57,23 @@ class _Walk:
         if isinstance(node, ir.Switch):
             ends = [self.body(c.body, state) for c in node.cases]
             return frozenset().union(*ends, self.body(node.default, state))
+        if isinstance(node, ir.Expanded):
+            return self.expanded(node, state)
         if isinstance(node, BLOCK_TYPES):
             return self.loop(node, state)
         return self.leaf(node, state)
+
+    def expanded(self, node: ir.Expanded, state: frozenset[int]) -> frozenset[int]:
+        """A routine's body at its call site: a return inside leaves to after the call, and
+        its labels are not the caller's (nor those of another call of it)."""
+        saved, saved_exits = self.scope, self.exits
+        self.scope, self.exits = f"{saved}{self.cursor}/", []
+        self.returns.append(set())
+        try:
+            end = self.body(node.body, state)
+        finally:
+            self.scope, self.exits = saved, saved_exits
+        return end | frozenset(self.returns.pop())
 
     def loop(self, node: Any, state: frozenset[int]) -> frozenset[int]:
         start, head = self.cursor, state
@@ -90,15 +106,17 @@ class _Walk:
             self._record(index, state)
             return frozenset({index}) if state else state  # no path reaches it
         if isinstance(node, ir.Goto):
-            self._add_label(node.label.upper(), state)
+            self._add_label(self.scope + node.label.upper(), state)
             return frozenset()
         if isinstance(node, ir.Label):
-            return state | self.labels[node.name.upper()]
+            return state | self.labels[self.scope + node.name.upper()]
         if isinstance(node, ir.Exit):
             if self.exits:
                 self.exits[-1].update(state)
             return frozenset()
         if isinstance(node, ir.Return):
+            if self.returns:
+                self.returns[-1].update(state)
             return frozenset()
         return state
 

@@ -78,7 +78,7 @@ from olp.posts.flow_text import (
     jump_problems,
 )
 from olp.posts.numbers import NumberFormat, Storage
-from olp.posts.rapid_flow import RapidWriter, counter_problems
+from olp.posts.rapid_flow import RapidWriter, counter_problems, reference_problems
 from olp.posts.rows import number_column
 from olp.posts.sandbox import SafeText
 from olp.posts.text import IDENTIFIER, NUMBER, ArgumentRule, NameRule, one_of
@@ -471,6 +471,9 @@ def _confdata_filter(post: Post, joints: ArrayLike, robot: Any) -> str:
 FILTERS: Mapping[str, Filter] = {
     **Post.FILTERS,
     "rapid_flow": flow_lines_filter,
+    "rapid_routine_head": lambda post, routine: post.flow.routine_head(routine),
+    "rapid_routine_end": lambda post, routine: post.flow.routine_end(routine),
+    "rapid_locals": lambda post, routine: post.flow.local_lines(routine),
     "rapid_pad": flow_pad_filter,
     "rapid_pose": rapid_pose,
     "rapid_robtarget": _robtarget_filter,
@@ -508,6 +511,7 @@ class AbbPost(Post):
     NULL_FRAME_NAME = NULL_FRAME_NAME
     PREDEFINED_NAMES = PREDEFINED_NAMES
     WRITES_FLOW = True
+    WRITES_ROUTINES = True
 
     def __init__(self, manifest: Any) -> None:
         super().__init__(manifest)
@@ -549,11 +553,13 @@ class AbbPost(Post):
         self.current_step = None
         flow = self.flow = self.writer([s.instruction for s in steps if s.kind in FLOW_STEP_KINDS])
         flow.prepare(steps)
+        # a routine's parameters and locals come as declare steps without an instruction index
+        own = frozenset(id(s.instruction) for s in steps if s.kind == "declare" and s.index < 0)
         return {
             "speeds": [{"name": k, "value": v} for k, v in speeds.items()],
             "zones": [{"name": k, "value": v} for k, v in zones.items()],
             "flow_kinds": FLOW_STEP_KINDS,
-            "routine_data": flow.declarations(exported=False),
+            "routine_data": flow.declarations(exported=False, skip=own),
             "module_data": flow.declarations(exported=True),
         }
 
@@ -610,8 +616,12 @@ class AbbPost(Post):
         mass or centre of gravity in the station); ``flow`` (error): a control-flow statement
         or declaration RAPID cannot hold exactly (:mod:`olp.posts.rapid_flow`)."""
         nodes = compiled.program.instructions
-        extra = [*jump_problems(nodes), *counter_problems(nodes)]
-        out: list[Diagnostic] = flow_problems(nodes, self.writer(nodes), extra)
+        routines = compiled.program.routines
+        table = {r.name.casefold(): r for r in routines}
+        extra = [*jump_problems(nodes), *counter_problems(nodes), *reference_problems(nodes, table)]
+        writer = self.writer(nodes)
+        extra += [found for r in routines for found in writer.routine_problems(r, table)]
+        out: list[Diagnostic] = flow_problems(nodes, writer, extra)
         loads: set[str] = set()
         for index, span, tool in _motion_tools(compiled):
             if tool is None or tool.pose is None or tool.name in loads:

@@ -136,6 +136,10 @@ class Post:
     KINDS: ClassVar[frozenset[str]] = ALL_KINDS
     """Instruction kinds the templates write."""
     WRITES_FLOW: ClassVar[bool] = False
+    WRITES_ROUTINES: ClassVar[bool] = False
+    """Whether the post writes the program's routines (:attr:`olp.ir.Program.routines`) as
+    routines of its language, and calls as calls (with ``routines: true`` in its manifest);
+    otherwise each routine's body is written out at every call (:meth:`writes_routines`)."""
     """Whether the templates write control flow and data statements (:mod:`olp.ir_flow`); a
     post that does not stops on a program holding them, naming the first one, rather than
     writing its instructions in a row. So does a template folder whose ``post.yaml`` does not
@@ -233,9 +237,18 @@ class Post:
     # ----------------------------------------------------------------------------------------
     # The pipeline
 
+    def writes_routines(self) -> bool:
+        """Whether this post, with its template folder, writes routines as routines."""
+        return self.WRITES_ROUTINES and self.manifest.routines
+
     def prepare(self, compiled: CompiledProgram) -> tuple[CompiledProgram, list[Diagnostic]]:
-        """Apply the ``TRANSFORMS`` in order."""
+        """Write routines out at their calls where the post does not write routines
+        (:func:`olp.posts.routines.written_out`), then apply the ``TRANSFORMS`` in order."""
+        from olp.posts.routines import written_out
+
         found: list[Diagnostic] = []
+        if compiled.program.routines and not self.writes_routines():
+            compiled, found = written_out(compiled, self)
         for transform in self.TRANSFORMS:
             compiled, more = transform(compiled, self)
             found += more
@@ -255,7 +268,13 @@ class Post:
                 continue
             out += self._shared_checks(item)
             out += self.check_instruction(item, compiled)
-        return out + self._acceleration_checks(compiled.steps) + self.check_program(compiled)
+        out += self._acceleration_checks(compiled.steps)
+        if compiled.program.routines and self.writes_routines():
+            from olp.posts.routines import once_per_statement, routine_checks
+
+            out += routine_checks(compiled, self)
+            return once_per_statement([*out, *self.check_program(compiled)])
+        return out + self.check_program(compiled)
 
     def check_block(self, block: PathBlock, compiled: CompiledProgram) -> list[Diagnostic]:
         """:meth:`check` of a toolpath's rows (linear moves to Cartesian targets, one tool

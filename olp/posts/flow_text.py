@@ -55,7 +55,7 @@ KRL_KINDS: Mapping[str, str] = {
 
 MARKER_KINDS = (
     *("if", "elif", "else", "end_if", "switch", "case", "default", "end_switch", "while"),
-    *("end_while", "repeat", "until", "loop", "end_loop", "for", "end_for"),
+    *("end_while", "repeat", "until", "loop", "end_loop", "for", "end_for", "routine_call"),
 )
 """The kinds of :func:`olp.posts.flow.weave`'s marker steps."""
 FLOW_STEP_KINDS = frozenset(
@@ -220,6 +220,8 @@ def exprs_of(node: Any) -> list[Any]:
     found = [getattr(node, f, None) for f in fields] + list(getattr(node, "dims", ()))
     found += [b.condition for b in getattr(node, "branches", ())]
     found += [v for c in getattr(node, "cases", ()) for v in c.values]
+    if isinstance(node, ir.RoutineCall | ir.Expanded):
+        found += list((node if isinstance(node, ir.RoutineCall) else node.call).args)
     return [e for e in found if e is not None]
 
 

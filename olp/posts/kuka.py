@@ -59,8 +59,21 @@ from olp.errors import PostError
 from olp.ir import ArcOrientation, CartesianTarget
 from olp.ir_flow import FLOW_TYPES, Declare, leaves_and_blocks
 from olp.posts.base import Filter, Post
-from olp.posts.kuka_flow import EVENT_KINDS, flow_problem, krl_decl, krl_event, krl_expr
+from olp.posts.kuka_flow import (
+    EVENT_KINDS,
+    flow_problem,
+    krl_call,
+    krl_decl,
+    krl_event,
+    krl_expr,
+    krl_param_decl,
+    krl_return,
+    krl_routine_end,
+    krl_routine_head,
+    routine_problem,
+)
 from olp.posts.numbers import NumberFormat, Storage
+from olp.posts.routines import flow_nodes_of_routines
 from olp.posts.sandbox import SafeText
 from olp.posts.text import IDENTIFIER, NUMBER, ArgumentRule, NameRule, double_quoted, one_of
 from olp.posts.view import RowColumns
@@ -419,6 +432,11 @@ FILTERS: Mapping[str, Filter] = {
     "krl_expr": lambda post, expr: krl_expr(expr),
     "krl_decl": lambda post, step: krl_decl(step),
     "krl_event": lambda post, node: krl_event(node),
+    "krl_routine_head": lambda post, routine: krl_routine_head(routine),
+    "krl_routine_end": lambda post, routine: krl_routine_end(routine),
+    "krl_param_decl": lambda post, param: krl_param_decl(param),
+    "krl_call": lambda post, call: krl_call(call),
+    "krl_return": lambda post, node: krl_return(node),
 }
 
 
@@ -430,6 +448,7 @@ class KukaPost(Post):
     LANGUAGE = "KRL"
     VERBATIM = "krl"
     WRITES_FLOW = True
+    WRITES_ROUTINES = True
     KINDS: ClassVar[frozenset[str]] = Post.KINDS | EVENT_KINDS
     NAME_RULE = NAME_RULE
     IO_RANGE = (1, 4096)
@@ -505,10 +524,19 @@ class KukaPost(Post):
           template folder that does not declare ``module_data: true`` (a copy made before
           olp placed declarations by scope would declare them all in the ``.src``)."""
         found = []
-        for node in leaves_and_blocks(compiled.program.instructions):
+        program = compiled.program
+        nodes = [*leaves_and_blocks(program.instructions), *flow_nodes_of_routines(program)]
+        seen = set()
+        for node in nodes:  # a routine's nodes are also in each of its expansions: once each
             if isinstance(node, FLOW_TYPES) and (problem := flow_problem(node)) is not None:
                 message = f"{node.kind.replace('_', ' ')} cannot be written in KRL: {problem}"
-                found.append(Diagnostic("error", "flow", message, node.span))
+                if (message, node.span) not in seen:
+                    seen.add((message, node.span))
+                    found.append(Diagnostic("error", "flow", message, node.span))
+        for routine in program.routines:
+            if (problem := routine_problem(routine)) is not None:
+                message = f"routine {routine.name} cannot be written in KRL: {problem}"
+                found.append(Diagnostic("error", "flow", message, routine.span))
         scoped = [
             n
             for n in leaves_and_blocks(compiled.program.instructions)

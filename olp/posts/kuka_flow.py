@@ -83,7 +83,7 @@ def _constant(expr: ir.Constant) -> str:
 def krl_decl(step: Any) -> str:
     """A :class:`olp.ir.Declare` as ``DECL TYPE name[dims]=value``; module data (the ``.dat``)
     also with the lines that set single array elements (``name[2]=5``) after it."""
-    decl: ir.Declare = step.instruction
+    decl: ir.Declare = step if isinstance(step, ir.Declare) else step.instruction
     dims = f"[{','.join(krl_expr(d) for d in decl.dims)}]" if decl.dims else ""
     value = "" if decl.value is None else f"={krl_expr(decl.value)}"
     prefix = ("GLOBAL " if decl.exported else "") + ("CONST " if decl.constant else "")
@@ -95,6 +95,63 @@ def krl_decl(step: Any) -> str:
     if bad is not None:  # flow_problem reports it first; never a line break from data
         raise ValueError(f"declaration of {decl.name}: control character {bad!r}")
     return SafeText("\n".join(lines))
+
+
+def krl_routine_head(routine: ir.Routine) -> str:
+    """``[GLOBAL] DEF name(p:IN, q:OUT)`` or ``[GLOBAL] DEFFCT TYPE[dims] name(...)``: an
+    ``"in"`` parameter is KRL's ``:IN`` (by value), an ``"out"`` one ``:OUT`` (by reference);
+    an array parameter has empty brackets (``sText[]:IN``). Its type is declared in the body
+    (:func:`krl_param_decl`)."""
+    params = ", ".join(
+        f"{p.name}{'[]' if p.dims else ''}:{'OUT' if p.by_reference else 'IN'}"
+        for p in routine.params
+    )
+    prefix = "GLOBAL " if routine.exported else ""
+    if routine.returns is None:
+        return f"{prefix}DEF {routine.name}({params})"
+    dims = (
+        f"[{','.join(krl_expr(d) for d in routine.returns_dims)}]" if routine.returns_dims else ""
+    )
+    return f"{prefix}DEFFCT {routine.returns}{dims} {routine.name}({params})"
+
+
+def krl_routine_end(routine: ir.Routine) -> str:
+    return "END" if routine.returns is None else "ENDFCT"
+
+
+def krl_param_decl(param: ir.Parameter) -> str:
+    """A parameter's type as KRL declares it in the routine: ``DECL INT nSlot`` (a parameter
+    without a type is not declared, as its source did not)."""
+    dims = f"[{','.join(krl_expr(d) for d in param.dims)}]" if param.dims else ""
+    return f"DECL {param.type_name} {param.name}{dims}"
+
+
+def krl_call(call: ir.RoutineCall) -> str:
+    """A call of a routine of the program: ``Name(arg, arg)``."""
+    return f"{call.name}({', '.join(krl_expr(a) for a in call.args)})"
+
+
+def krl_return(node: ir.Return) -> str:
+    return "RETURN" if node.value is None else f"RETURN {krl_expr(node.value)}"
+
+
+def routine_problem(routine: ir.Routine) -> str | None:
+    """Why ``routine``'s head and declarations cannot be written as KRL, or None."""
+    for name in [routine.name, *(p.name for p in routine.params), routine.returns or "X"]:
+        if not _IDENTIFIER.match(name):
+            return f"{name!r} is not a KRL name"
+    for param in routine.params:
+        if param.type_name and not _IDENTIFIER.match(param.type_name):
+            return f"{param.type_name!r} is not a KRL type name"
+    for expr in [*routine.returns_dims, *(d for p in routine.params for d in p.dims)]:
+        problem = None if expr is None else _expr_problem(expr)
+        if problem is not None:
+            return problem
+    for decl in routine.declarations:
+        problem = flow_problem(decl)
+        if problem is not None:
+            return problem
+    return None
 
 
 def krl_event(node: Any) -> str:
@@ -146,6 +203,8 @@ def _names(node: Any) -> list[str]:
         return [node.name if isinstance(node, ir.Label) else node.label]
     if isinstance(node, ir.For):
         return [node.variable]
+    if isinstance(node, ir.RoutineCall):
+        return [node.name]
     return []
 
 
@@ -158,6 +217,8 @@ def _exprs(node: Any) -> list[Any]:
         found += [e for indices, value in node.elements for e in (*indices, value)]
     if isinstance(node, ir.InterruptDecl):
         found.append(node.handler)
+    if isinstance(node, ir.RoutineCall):
+        found += [a for a in node.args if a is not None]
     if isinstance(node, ir.PathTrigger):
         action = node.action
         found += [action.target, action.value] if isinstance(action, ir.Assign) else [action]

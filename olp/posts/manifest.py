@@ -27,6 +27,9 @@ The manifest says::
                                       # false: a folder copied before olp wrote them, which
                                       # would write every block's body unconditionally; a post
                                       # that checks it stops on a program with control flow)
+    routines: true                    # the templates write the program's routines (default
+                                      # false: a folder copied before olp wrote them gets each
+                                      # routine's body written out at every call instead)
     module_data: true                 # the templates place declarations by scope (module
                                       # data in the data list, external names not declared);
                                       # default false: a folder copied before, which a post
@@ -73,6 +76,7 @@ class PostManifest:
     rows: bool = False
     accelerations: bool = False
     flow: bool = False
+    routines: bool = False
     module_data: bool = False
 
 
@@ -91,8 +95,8 @@ def load_manifest(folder: Path) -> PostManifest:
     frames_in = str(raw.get("frames_in", "world"))
     if frames_in not in FRAMES_IN:
         raise PostError(f"{path}: frames_in must be one of {', '.join(FRAMES_IN)}")
-    keys = ("rows", "accelerations", "flow", "module_data")
-    rows, accelerations, flow, module_data = (_flag(raw, key, path) for key in keys)
+    keys = ("rows", "accelerations", "flow", "module_data", "routines")
+    rows, accelerations, flow, module_data, routines = (_flag(raw, key, path) for key in keys)
     return PostManifest(
         name=str(raw.get("name", folder.name)),
         vendor=str(raw.get("vendor", "")),
@@ -109,6 +113,7 @@ def load_manifest(folder: Path) -> PostManifest:
         accelerations=accelerations,
         flow=flow,
         module_data=module_data,
+        routines=routines,
     )
 
 

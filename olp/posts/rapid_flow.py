@@ -38,6 +38,17 @@ Blocks
   into a block, a label defined twice (a routine inlined twice) and a missing label.
   ``rapidchecker``'s grammar has no labels, so files with labels cannot be checked by it.
 * ``RETURN;`` ends the entry routine, as reaching its ``ENDPROC`` does.
+* Routines of the program follow the entry routine in the module: ``PROC name(num a, INOUT
+  num b)`` ... ``ENDPROC``, a function ``FUNC bool name(num a)`` ... ``RETURN value;`` ...
+  ``ENDFUNC``, their own data (``VAR num n;``) at their top; a call is ``name a, b;`` (a
+  procedure call names the routine and its arguments without parentheses). An ``"in"``
+  parameter is a plain one (by value); an ``"out"`` one is ``INOUT`` (by reference: the
+  caller's variable, VAR or PERS, is changed), and its argument must be a variable. All of this
+  is from memory of the RAPID reference (PROC, FUNC, "Parameters"), unverified against a stored
+  copy; ``rapidchecker`` accepts the files. Not written (errors): array parameters and results,
+  an ``INOUT`` parameter of a FUNC (whether RAPID allows it is unverified), a parameter without
+  a type, and REPEAT or EXIT in a routine other than the entry one (their helper flag and exit
+  label are the entry routine's).
 * A wait on a condition is ``WaitUntil \\InPos, c;``: ``\\InPos`` waits for the robot to stand
   still before the condition is evaluated, as KRL's ``WAIT FOR`` stops the advance run (RAPID
   reference, WaitUntil, as recalled; medium confidence).
@@ -99,6 +110,7 @@ from olp.posts.flow_text import (
     for_problem,
     initial_value,
     string_index,
+    variable_of,
     walk,
 )
 from olp.posts.text import NameRule
@@ -177,13 +189,15 @@ class RapidWriter(FlowWriter):
 
     # ---- data
 
-    def declarations(self, exported: bool) -> list[str]:
+    def declarations(self, exported: bool, skip: frozenset[int] = frozenset()) -> list[str]:
         """``VAR num n;`` lines of the declared variables (module data when ``exported``, else
-        routine data, where the helper flags go too)."""
+        routine data, where the helper flags go too); ``skip``: ids of declarations that are
+        not the main routine's (a routine's parameters and locals)."""
         out = [
             self.declaration(var) + ";"
             for var in self.symbols.variables.values()
             if (var.declare.exported or var.declare.scope == "module") == exported
+            and id(var.declare) not in skip
         ]
         if not exported:
             out += [f"VAR {RAPID_TYPES[kind]} {name};" for name, kind in self.helpers]
@@ -384,7 +398,77 @@ class RapidWriter(FlowWriter):
         return [(self.depth, f"GOTO {self.exits[id(loop.node)]};")]
 
     def _return(self, node: ir.Return) -> list[tuple[int, str]]:
-        return [(self.depth, "RETURN;")]
+        if node.value is None:
+            return [(self.depth, "RETURN;")]
+        return [(self.depth, f"RETURN {self.expr(node.value)};")]
+
+    def _routine_call(self, node: ir.RoutineCall) -> list[tuple[int, str]]:
+        args = ", ".join(self.expr(a) for a in node.args)
+        return [
+            (self.depth, f"{self.name(node.name)} {args};" if args else f"{self.name(node.name)};")
+        ]
+
+    # ---- routines
+
+    def routine_head(self, routine: ir.Routine) -> str:
+        """``PROC name(num a, INOUT num b)`` or ``FUNC bool name(num a)``."""
+        params = ", ".join(self._parameter(routine, p) for p in routine.params)
+        if routine.returns is None:
+            return f"  PROC {self.name(routine.name)}({params})"
+        result = ir.Declare(name=routine.name, type_name=routine.returns, dims=routine.returns_dims)
+        var = variable_of(result)
+        if var.dims:
+            raise FlowProblem(f"{routine.name} returns an array, which olp does not write in RAPID")
+        return f"  FUNC {RAPID_TYPES[var.kind]} {self.name(routine.name)}({params})"
+
+    def _parameter(self, routine: ir.Routine, param: ir.Parameter) -> str:
+        if not param.type_name:
+            raise FlowProblem(f"parameter {param.name} has no type, which RAPID must state")
+        var = variable_of(ir.Declare(name=param.name, type_name=param.type_name, dims=param.dims))
+        if var.dims:
+            raise FlowProblem(f"{param.name} is an array parameter, which olp does not write yet")
+        if param.by_reference and routine.is_function:
+            raise FlowProblem(
+                f"{param.name} of the function {routine.name} is passed by reference; olp "
+                "writes INOUT parameters of a PROC only (unverified for a FUNC)"
+            )
+        inout = "INOUT " if param.by_reference else ""
+        return f"{inout}{RAPID_TYPES[var.kind]} {self.name(param.name)}"
+
+    @staticmethod
+    def routine_end(routine: ir.Routine) -> str:
+        return "  ENDPROC" if routine.returns is None else "  ENDFUNC"
+
+    def local_lines(self, routine: ir.Routine) -> list[str]:
+        """A routine's own data: ``VAR num rDepth;`` at its top."""
+        return [
+            " " * self.BASE_INDENT + self.declaration(variable_of(d)) + ";"
+            for d in routine.declarations
+        ]
+
+    def routine_problems(
+        self, routine: ir.Routine, table: dict[str, ir.Routine]
+    ) -> list[tuple[Any, str]]:
+        """What of ``routine`` RAPID cannot say exactly (see the module docstring)."""
+        out: list[tuple[Any, str]] = []
+        try:
+            self.routine_head(routine)
+            self.local_lines(routine)
+        except FlowProblem as exc:
+            out.append((routine, str(exc)))
+        for node in leaves_and_blocks(routine.body):
+            helper = isinstance(node, ir.Repeat) or (
+                isinstance(node, (ir.While, ir.Loop, ir.For)) and direct_exit(node)
+            )
+            if helper:
+                out.append(
+                    (
+                        node,
+                        "olp writes REPEAT and EXIT in the main routine only (their "
+                        "helper flag or label is the main routine's)",
+                    )
+                )
+        return out
 
     # ---- blocks
 
@@ -488,3 +572,26 @@ def _counter_walk(
             inner = active | {node.variable.casefold()} if isinstance(node, ir.For) else active
             for body in bodies(node):
                 _counter_walk(body, counters, inner, out)
+
+
+def reference_problems(nodes: Sequence[Any], table: dict[str, ir.Routine]) -> list[tuple[Any, str]]:
+    """Calls that give an INOUT parameter something other than a variable (RAPID passes a
+    variable by reference; a value cannot be one)."""
+    out: list[tuple[Any, str]] = []
+    for node in leaves_and_blocks(nodes):
+        call = node.call if isinstance(node, ir.Expanded) else node
+        if not isinstance(call, ir.RoutineCall):
+            continue
+        routine = table.get(call.name.casefold())
+        if routine is None:
+            continue
+        for param, arg in zip(routine.params, call.args, strict=False):
+            if param.by_reference and not isinstance(arg, ir.Name | ir.Index | ir.Member):
+                out.append(
+                    (
+                        call,
+                        f"{param.name} of {routine.name} is INOUT: the call must give it a "
+                        "variable",
+                    )
+                )
+    return out

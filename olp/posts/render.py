@@ -26,12 +26,18 @@ Template context (every file)
     In ``main_files``: the parts in call order, each ``{name, index, routine}``; else empty.
 ``steps``
     This file's instructions (:class:`olp.posts.view.PostStep`); empty in ``main_files``.
+``routines``
+    Where the post writes routines (``Post.writes_routines``): the program's routines, each
+    a :class:`olp.posts.flow.RoutineSteps` (``routine``: the :class:`olp.ir.Routine`,
+    ``steps``: its body as steps); else empty.
 ``tools`` / ``frames``
     The tools and frames this file's motions use (the main: all of the program's), each a
     :class:`~olp.posts.view.PostTool` / :class:`~olp.posts.view.PostFrame` with a legal unique
     name.
 ``vendor``
-    What the post's ``context_values`` returns for this file (ABB's custom speed and zone data).
+    What the post's ``context_values`` returns for this file (ABB's custom speed and zone data);
+    it is given the routines' statements too (their parameters and local declarations as
+    ``declare`` steps first).
 ``modal``
     A :class:`~olp.posts.view.Modal` change tracker: ``modal.changed("cdis", v)``; fresh for
     every file.
@@ -54,7 +60,7 @@ from olp.compiled import BlockRows, PathBlock, StepBlocks, items_of, pieces
 from olp.diagnostics import Diagnostic
 from olp.errors import PostError
 from olp.ir import is_motion
-from olp.posts.flow import weave
+from olp.posts.flow import RoutineSteps, routine_statements, weave, weave_routines
 from olp.posts.rows import PostRows
 from olp.posts.text import basename
 from olp.posts.view import (
@@ -258,11 +264,18 @@ class _Renderer:
         unit_name: str | None = None,
     ) -> dict[str, Any]:
         view: Sequence[Any] = self.view.unit_steps(steps, allocation)
+        every = view  # a routine's motions are among these
+        routines: list[RoutineSteps] = []
         if self.post.WRITES_FLOW and self.compiled.program.has_flow:
             # a program with control flow is rendered from steps only (Post.columns_enabled)
+            if self.post.writes_routines():
+                lines = self.post.comment_lines
+                routines = weave_routines(self.compiled.program, view, lines)
             view = weave(self.compiled.program, view)
         unit = Unit(unit_name or self.name, self.name, self.source, index, count, routine)
-        return unit_context(self.post, self.compiled.station, unit, allocation, view)
+        return unit_context(
+            self.post, self.compiled.station, unit, allocation, view, routines, every
+        )
 
     def _files(
         self,
@@ -288,10 +301,20 @@ class Unit:
 
 
 def unit_context(
-    post: Post, station: Any, unit: Unit, allocation: Allocation, view: Sequence[Any]
+    post: Post,
+    station: Any,
+    unit: Unit,
+    allocation: Allocation,
+    view: Sequence[Any],
+    routines: Sequence[RoutineSteps] = (),
+    every: Sequence[Any] | None = None,
 ) -> dict[str, Any]:
-    """The template context of one file whose steps are ``view`` (see the module text)."""
-    tools, frames = _used(allocation, view)
+    """The template context of one file whose steps are ``view`` (see the module text), with
+    the program's ``routines`` where the post writes them; ``every``: the file's steps before
+    weaving (a routine's motions among them), for its tools and frames."""
+    tools, frames = _used(allocation, view if every is None else every)
+    vendor = post.context_values([*routine_statements(routines), *view])
+    written = [RoutineSteps(r.routine, TrackedSteps(post.group(r.steps), post)) for r in routines]
     return {
         "program": {"name": unit.name, "source": unit.source, "main": unit.main},
         "split": unit.count > 0,
@@ -305,9 +328,10 @@ def unit_context(
         },
         "parts": [],
         "steps": TrackedSteps(post.group(view), post),
+        "routines": written,
         "tools": tools,
         "frames": frames,
-        "vendor": post.context_values(view),
+        "vendor": vendor,
         "station": station,
         "robot": station.robot,
         "options": post.manifest.options,

@@ -311,6 +311,8 @@ def _blends_filter(post: Post, steps: Any, station: Any) -> dict[int, float]:
 FILTERS: Mapping[str, Filter] = {
     **Post.FILTERS,
     "ur_flow": flow_lines_filter,
+    "ur_routine_head": lambda post, routine: post.flow.routine_head(routine),
+    "ur_local": lambda post, decl: post.flow.local_declaration(decl),
     "ur_pad": flow_pad_filter,
     "ur_pose": ur_pose,
     "ur_joints": ur_joints,
@@ -440,6 +442,7 @@ class UrPost(Post):
     ARC_ORIENTATIONS = frozenset({ArcOrientation.INTERPOLATE, ArcOrientation.PATH_CONSTANT})
     WRITES_FLOW = True
     COLUMNS = True
+    WRITES_ROUTINES = True
 
     def __init__(self, manifest: Any) -> None:
         super().__init__(manifest)
@@ -475,7 +478,11 @@ class UrPost(Post):
         exactly (:mod:`olp.posts.ur_flow`); ``module_data`` (warning): module data the program
         assigns, whose value a URScript run does not keep for the next."""
         nodes = compiled.program.instructions
-        found = flow_problems(nodes, self.writer(nodes)) + arc_blends(compiled)
+        routines = compiled.program.routines
+        own = [n for r in routines for n in (*_param_declarations(r), *r.declarations)]
+        writer = self.writer([*own, *nodes])
+        extra = [found for r in routines for found in writer.routine_problems(r)]
+        found = flow_problems(nodes, writer, extra) + arc_blends(compiled)
         found += [
             Diagnostic(
                 "warning",
@@ -499,6 +506,15 @@ class UrPost(Post):
                 hint="split the program or stream it to the controller",
             ),
         ]
+
+
+def _param_declarations(routine: Any) -> list[ir.Declare]:
+    """A routine's typed parameters as declarations (their types, for the writer)."""
+    return [
+        ir.Declare(name=p.name, type_name=p.type_name, dims=p.dims, span=p.span)
+        for p in routine.params
+        if p.type_name
+    ]
 
 
 def arc_blends(compiled: CompiledProgram) -> list[Diagnostic]:

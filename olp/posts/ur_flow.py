@@ -30,6 +30,15 @@ Blocks
 * A wait on a condition polls once per control cycle: ``while not (c):`` ``sync()`` ``end``,
   as the post already waits for an input.
 * Labels and GOTO: URScript has no jump; they are an error naming the line.
+* Routines of the program are functions defined at the top of the program's ``def``:
+  ``def name(a, b):`` ... ``end`` (Polyscope writes a program's subprograms so; the manual's
+  Functions section, as recalled), with ``local`` variables of their own and ``return value``
+  for a function's result. URScript passes arguments by value (as recalled; unverified against
+  a stored manual): an ``"out"`` parameter the routine changes (assigns, counts with, or hands
+  to a call) is an error on the routine, because the caller would not see the change; one it
+  only reads is exact by value and written. A routine that assigns a variable of the program
+  is an error: whether that assignment in a function reaches the program's variable or makes a
+  local one is unverified.
 * A block whose body is empty (a KRL ``IF`` with only an ``ELSE`` body, a dropped line) is
   written empty (``if c:`` then ``else:``); whether URScript accepts an empty body is
   unverified (a script it refuses does not run: no motion follows from it).
@@ -78,6 +87,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from olp import ir
+from olp.ir_flow import leaves_and_blocks
 from olp.posts.flow_text import (
     FlowProblem,
     FlowWriter,
@@ -90,6 +100,7 @@ from olp.posts.flow_text import (
     for_problem,
     initial_value,
     string_index,
+    variable_of,
     walk,
 )
 from olp.posts.text import NameRule
@@ -305,7 +316,45 @@ class UrWriter(FlowWriter):
         return [(self.depth, "break")]
 
     def _return(self, node: ir.Return) -> list[tuple[int, str]]:
-        return [(self.depth, "return")]
+        if node.value is None:
+            return [(self.depth, "return")]
+        return [(self.depth, f"return {self.expr(node.value)}")]
+
+    def _routine_call(self, node: ir.RoutineCall) -> list[tuple[int, str]]:
+        args = ", ".join(self.expr(a) for a in node.args)
+        return [(self.depth, f"{self.name(node.name)}({args})")]
+
+    # ---- routines
+
+    def routine_head(self, routine: ir.Routine) -> str:
+        """``def name(a, b):``, at the program's first level (a function of the program)."""
+        params = ", ".join(self.name(p.name) for p in routine.params)
+        return " " * self.BASE_INDENT + f"def {self.name(routine.name)}({params}):"
+
+    def local_declaration(self, decl: ir.Declare) -> str:
+        """A routine's own variable: ``local name = value`` inside its ``def``."""
+        text = self.declaration(variable_of(decl))
+        return " " * (self.BASE_INDENT + self.STEP) + text.replace("global ", "local ", 1)
+
+    def routine_problems(self, routine: ir.Routine) -> list[tuple[Any, str]]:
+        """What of ``routine`` URScript cannot say exactly (see the module docstring)."""
+        out: list[tuple[Any, str]] = []
+        try:
+            self.routine_head(routine)
+            for decl in routine.declarations:
+                self.local_declaration(decl)
+        except FlowProblem as exc:
+            out.append((routine, str(exc)))
+        own = {p.name.casefold() for p in routine.params}
+        own |= {d.name.casefold() for d in routine.declarations}
+        changed = _changed_names(routine.body)
+        for param in routine.params:
+            if param.by_reference and param.name.casefold() in changed:
+                out.append((routine, _by_value(routine, param)))
+        for node, name in _assignments(routine.body):
+            if name.casefold() not in own:
+                out.append((node, _global_assignment(routine, name)))
+        return out
 
     # ---- blocks
 
@@ -379,3 +428,44 @@ class UrWriter(FlowWriter):
         counter, _, _, _, step = self.for_head(node)
         increment = (self.depth, f"{counter} = {counter} {step}")
         return [increment, *self._end()]
+
+
+def _base_name(expr: Any) -> str | None:
+    while isinstance(expr, ir.Index | ir.Member):
+        expr = expr.base
+    return expr.name if isinstance(expr, ir.Name) else None
+
+
+def _assignments(nodes: Sequence[Any]) -> list[tuple[Any, str]]:
+    """(node, variable) for every assignment and FOR counter of ``nodes``."""
+    out = []
+    for node in leaves_and_blocks(nodes):
+        target = node.target if isinstance(node, ir.Assign) else None
+        name = node.variable if isinstance(node, ir.For) else _base_name(target)
+        if name is not None:
+            out.append((node, name))
+    return out
+
+
+def _changed_names(nodes: Sequence[Any]) -> set[str]:
+    """Variables ``nodes`` may change (case-folded): assigned, counted, or handed to a call
+    (which may take them by reference)."""
+    names = {name.casefold() for _, name in _assignments(nodes)}
+    for node in leaves_and_blocks(nodes):
+        if isinstance(node, ir.RoutineCall):
+            names |= {n.casefold() for a in node.args if (n := _base_name(a)) is not None}
+    return names
+
+
+def _by_value(routine: ir.Routine, param: ir.Parameter) -> str:
+    return (
+        f"parameter {param.name} of {routine.name} is passed by reference (OUT) and the routine "
+        "changes it; URScript passes parameters by value, so the caller would not see the change"
+    )
+
+
+def _global_assignment(routine: ir.Routine, name: str) -> str:
+    return (
+        f"{routine.name} assigns {name}, a variable of the program; how a URScript function "
+        "assigns a program variable is unverified, so olp does not write it"
+    )

@@ -375,7 +375,14 @@ def test_other_routines_are_listed() -> None:
     routines = "\nDEF helper ( )\n  PTP HOME\nEND\nDEFFCT INT f()\nRETURN 1\nENDFCT\n"
     result = parse_krl(program(f"LIN {FULL}") + routines)
     ignored = [(i.span.line, i.text) for i in result.ignored]
-    assert ignored == [(5, "DEF helper ( )"), (8, "DEFFCT INT f()")]
+    assert ignored == [(5, "DEF helper ( )")]  # never called, and olp cannot lower it
+    assert "is never called" in result.ignored[0].reason
+    (function,) = result.program.routines  # a function without motions is kept
+    assert (function.name, function.returns, [n.kind for n in function.body]) == (
+        "f",
+        "INT",
+        ["return"],
+    )
 
 
 # ---- errors -----------------------------------------------------------------------------------

@@ -51,22 +51,28 @@ def test_array_parameters_and_array_results() -> None:
         "$OUT[80]=TRUE\nEND\n"
         'DEFFCT CHAR[128] Text(nNumber:IN)\nDECL INT nNumber\nRETURN "x"\nENDFCT\n'
     )
-    kinds = [i.kind for i in result.program if i.kind not in ("declare", "assign")]
-    assert kinds == ["set_output"]  # Show(sMsg[]:IN, ...) inlined
+    kinds = [i.kind for i in result.program.expanded() if i.kind not in ("declare", "assign")]
+    assert kinds == ["set_output"]  # Show(sMsg[]:IN, ...) at its call
+    show, text = result.program.routines
+    assert [(p.name, p.type_name, len(p.dims), p.direction) for p in show.params] == [
+        ("sMsg", "CHAR", 1, "in"),
+        ("nLevel", "INT", 0, "in"),
+    ]
+    assert (text.returns, len(text.returns_dims)) == ("CHAR", 1)
 
 
-def test_a_module_of_functions_only_is_an_empty_program_with_every_function_listed() -> None:
+def test_a_module_of_functions_only_is_an_empty_program_with_every_function_kept() -> None:
     path = CONTROLLER / "Program" / "msg_lib.src"
     result = load_krl(path, CONFIG)
     assert (result.program.name, len(result.program)) == ("msg_lib", 0)
-    ours = [i for i in result.ignored if i.span.file == str(path)]
-    listed = [(i.span.line, i.text.split("(")[0]) for i in ours]
-    assert listed == [
-        (5, "GLOBAL DEFFCT INT MsgNotify"),
-        (18, "GLOBAL DEFFCT CHAR[128] MsgText"),
-        (27, "GLOBAL DEFFCT BOOL MsgClear"),
+    functions = [(r.name, r.returns, r.exported) for r in result.program.routines]
+    assert functions == [
+        ("MsgNotify", "INT", True),
+        ("MsgText", "CHAR", True),
+        ("MsgClear", "BOOL", True),
     ]
-    assert all("no DEF to run" in i.reason for i in result.ignored if i.span.file == str(path))
+    returns = [n for r in result.program.routines for n in r.body if isinstance(n, ir.Return)]
+    assert len(returns) == 3 and all(r.value is not None for r in returns)
 
 
 def test_the_program_is_the_first_def_even_after_functions() -> None:

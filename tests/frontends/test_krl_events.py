@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from olp import ir
-from olp.frontends.krl import load_krl
+from olp.frontends.krl import load_krl, parse_krl
 from olp.ir_flow import leaves_and_blocks
 
 REPO = Path(__file__).resolve().parents[2]
@@ -151,14 +151,29 @@ def test_event_nodes_refuse_values_they_cannot_hold(make: object, message: str) 
         make()  # type: ignore[operator]
 
 
-def test_a_handler_routine_of_the_module_is_named_as_missing_from_the_output() -> None:
-    """The handler is not called where the interrupt is declared, so it is not inlined; the
-    warning says the written program's interrupt calls a routine it does not hold."""
+def test_a_handler_routine_of_the_module_is_kept_as_a_routine() -> None:
+    """The handler is not called where the interrupt is declared; it does not move the robot,
+    so it is a routine of the program (it was a warning naming it missing from the output)."""
     result = load_krl(CORPUS / "Program" / "interrupt_watch.src", CONFIG)
-    (line,) = [i for i in result.ignored if "CURTAIN_STOP" in i.reason]
-    assert line.span.line == 24
-    assert "runs from the interrupt at line 11" in line.reason
-    assert "does not hold" in line.reason
+    assert not [i for i in result.ignored if "CURTAIN_STOP" in i.reason]
+    (handler,) = result.program.routines
+    assert (handler.name, handler.span.line) == ("CURTAIN_STOP", 24)
+    kinds = [n.kind for n in handler.body]
+    assert kinds == ["verbatim", "set_output", "wait_input", "set_output", "verbatim"]
+
+
+def test_a_handler_that_moves_the_robot_is_named_as_missing_from_the_output() -> None:
+    """Where a handler runs is unknown, so its motions could not be checked: not written, and
+    the warning says the written program's interrupt calls a routine it does not hold."""
+    source = (
+        "DEF p( )\nINTERRUPT DECL 20 WHEN $IN[3] DO Away()\nINTERRUPT ON 20\nWAIT SEC 1\nEND\n"
+        "DEF Away( )\nPTP {A1 0,A2 -90,A3 90,A4 0,A5 0,A6 0}\nEND\n"
+    )
+    result = parse_krl(source)
+    (line,) = [i for i in result.ignored if "Away" in i.reason]
+    assert line.span.line == 6 and not result.program.routines
+    assert "runs from the interrupt at line 2" in line.reason
+    assert "moves the robot" in line.reason
 
 
 def test_interrupts_and_triggers_take_no_time() -> None:

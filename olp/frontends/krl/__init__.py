@@ -10,8 +10,8 @@ motion state) -> IR. Data lists (the module's ``.dat``, a ``$config.dat``) are r
 What is lowered
 ---------------
 * **Files.** ``&`` header lines, several ``DEF``/``DEFFCT`` routines, ``;FOLD`` comments. The
-  first ``DEF`` is the program (a module of ``DEFFCT`` functions only is an empty program, each
-  function listed as not lowered). Declarations may leave out ``DECL`` for the simple and the
+  first ``DEF`` is the program (a module of ``DEFFCT`` functions only is an empty program
+  holding the functions as routines). Declarations may leave out ``DECL`` for the simple and the
   predefined structure types (``FRAME lfOffset``, ``E6AXIS XHOME={...}``, as a controller's
   ``$config.dat`` writes them); parameters may be arrays (``sText[]:IN``) and functions may
   return one (``DEFFCT CHAR[128]``). :func:`load_krl` reads the ``.dat`` beside the ``.src`` (same
@@ -81,10 +81,19 @@ What is lowered
   This follows KUKA's documented meaning of BAS and the inline forms; it is not verified
   against ``BAS.SRC`` or a controller (which of the BAS value and PDAT VEL wins, and whether
   WITH values outlast their motion, are the main open questions).
-* **Calls.** A call of another ``DEF`` of the module is inlined (parameters by value where the
-  arguments are constant; others are unknown inside; parameters not marked ``:IN`` are copied
-  back to a plain variable argument); recursion is an error. Other calls become
-  :class:`~olp.ir.Call` (arguments as source text).
+* **Routines and calls.** The module's other ``DEF``/``DEFFCT`` routines are
+  :class:`~olp.ir.Routine`\\ s of the program (:attr:`olp.ir.Program.routines`): parameters
+  with their direction (``:IN`` by value, ``:OUT`` or no mark by reference) and the type their
+  ``DECL`` gives, local declarations, the result type of a ``DEFFCT`` and ``RETURN value``,
+  ``GLOBAL``. A call of a ``DEF`` is lowered at each call from the state there (parameters by
+  value where the arguments are constant; others are unknown inside; parameters not marked
+  ``:IN`` are copied back to a plain variable argument), then kept as an
+  :class:`~olp.ir.RoutineCall` where every call lowered the same routine
+  (:mod:`olp.frontends.krl.routines`; otherwise written out at its calls with a warning);
+  recursion is an error. Checks see each routine's body at every call
+  (:meth:`olp.ir.Program.expanded`). Routines no call reaches (interrupt handlers, functions)
+  are kept unless they move the robot. Other calls become :class:`~olp.ir.Call` (arguments as
+  source text).
 * **Control flow** becomes :mod:`olp.ir_flow` blocks (re-exported from :mod:`olp.ir`): ``IF``
   -> :class:`~olp.ir.If`, ``SWITCH`` -> :class:`~olp.ir.Switch`, ``WHILE``/``REPEAT``/``LOOP``
   -> :class:`~olp.ir.While`/:class:`~olp.ir.Repeat`/:class:`~olp.ir.Loop`, ``EXIT`` ->
@@ -99,7 +108,8 @@ What is lowered
   and :data:`~olp.frontends.krl.lower.MAX_LOWERED_STATEMENTS` statements in all); others are a
   :class:`~olp.ir.For` block. A jump back to a label makes the variables the routine assigns
   unknown there; one with other motion settings than the label had is an error. ``SPLINE ...
-  ENDSPLINE`` blocks are rejected. ``RETURN`` inside a block of an inlined routine is rejected.
+  ENDSPLINE`` blocks are rejected. ``RETURN`` inside a block of a called routine is rejected
+  (olp lowers it at each call).
 * **Motions to where the robot is** (``PTP $POS_ACT``, ``PTP $AXIS_ACT``: the block
   coincidence run) are kept as written (:class:`olp.ir.Verbatim`): there is nothing to check.
   A motion to a value derived from them at run time (``lNow.Z = lNow.Z + 100``, ``LIN lNow``)

@@ -367,6 +367,7 @@ class Other:
     kind: str
     span: ir.SourceSpan
     name: str | None = None  # a label's or a GOTO's label name
+    value: Expr | None = None  # what a RETURN gives back (a function's result)
 
 
 @dataclass(frozen=True, slots=True)
@@ -435,6 +436,9 @@ class Routine:
     params: tuple[Param, ...]
     body: tuple[Stmt, ...]
     span: ir.SourceSpan
+    exported: bool = False  # GLOBAL DEF / GLOBAL DEFFCT
+    returns: str | None = None  # a DEFFCT's result type
+    returns_dims: tuple[Expr | None, ...] = ()  # DEFFCT CHAR[128]
 
 
 @dataclass(frozen=True, slots=True)

@@ -1,7 +1,8 @@
 """KRL AST -> :class:`olp.ir.Program`: the statement walk, calls and loops.
 
 See :mod:`olp.frontends.krl` for what is lowered and the decisions behind it. In short: the first
-DEF is the program; calls of other DEFs of the module are inlined; FOR loops with constant
+DEF is the program; calls of other DEFs of the module are lowered at each call and kept as
+calls of routines (:mod:`olp.frontends.krl.routines`); FOR loops with constant
 bounds are unrolled; straight-line statements are lowered; other control flow is ignored when
 lowering it would change nothing, and rejected (naming the construct and its line) otherwise.
 """
@@ -49,6 +50,7 @@ from olp.frontends.krl.events import Events
 from olp.frontends.krl.flow import assigned_names, is_straight, jump_targets, statements, to_expr
 from olp.frontends.krl.module_data import with_module_data
 from olp.frontends.krl.motion import Motions
+from olp.frontends.krl.routines import PendingCall, assemble, moves
 from olp.frontends.krl.rows import build_instructions
 from olp.frontends.krl.state import (
     DEFAULT_VEL_CP,
@@ -138,6 +140,8 @@ class _Lowering(Motions, Events):
         self.in_block = 0
         self.jumped: int | None = None  # line of a GOTO after which nothing is reached
         self.routine = RoutineJumps()
+        self.defining: str | None = None  # a routine lowered on its own (no call reaches it)
+        self.generic = False  # lowering a called routine with its parameters unknown
         self._blocks: dict[str, Callable[[Block], None]] = {
             "IF": self._if,
             "SWITCH": self._switch,
@@ -280,8 +284,9 @@ class _Lowering(Motions, Events):
     def _inline(self, routine: Routine, stmt: CallStmt) -> None:
         """Lower the body of a DEF of this module in place of its call."""
         name = routine.name.upper()
-        if name in self.call_stack or name == self.ctx.main:
-            chain = " -> ".join([self.ctx.main, *self.call_stack, name])
+        first = self.defining or self.ctx.main
+        if name in self.call_stack or name == first.upper():
+            chain = " -> ".join([first, *self.call_stack, name])
             raise self._error(
                 f"recursive call of {routine.name} ({chain}): olp inlines calls and cannot "
                 "inline recursion",
@@ -301,21 +306,70 @@ class _Lowering(Motions, Events):
         saved = self.returned, self.exiting, self.loop_depth, self.loops, self.routine, self.jumped
         self.returned, self.exiting, self.loop_depth, self.loops = None, None, 0, []
         self.routine, self.jumped = RoutineJumps.of(routine.body), None
+        caller_out, self.out = self.out, []
         try:
             self.first_pass(routine.body)
             self.lower_body(routine.body)
         finally:
+            lowered, self.out = self.out, caller_out
             finals = self.variables.pop()
             self.call_stack.pop()
             self.returned, self.exiting, self.loop_depth, self.loops, self.routine = saved[:5]
             self.jumped = saved[5]
         self._write_back(routine, stmt, bound, finals)
+        args = tuple(to_expr(arg, self._input_index) for arg in stmt.args)
+        call = ir.RoutineCall(name=routine.name, args=args, span=stmt.span)
+        body = build_instructions(lowered)
+        generic = self._generic_body(routine, stmt) if self._reads_params(routine) else None
+        pending = PendingCall(call=call, body=body, generic=generic, span=stmt.span)
+        self.out.append(pending)  # type: ignore[arg-type]  # made a call by routines.assemble
+
+    def _reads_params(self, routine: Routine) -> bool:
+        """Whether a statement of ``routine`` other than a motion or a declaration names one of
+        its parameters (then its lowering with the parameters unknown may be the one text of
+        calls that differ; otherwise that lowering differs as the calls do and is not made:
+        it costs a second lowering of the body at each call). By the source text, so a name
+        in a comment counts too (it only costs time)."""
+        key = routine.name.upper()
+        found = self.ctx.reads_params.get(key)
+        if found is None:
+            words = [re.compile(rf"\b{re.escape(p.name)}\b", re.IGNORECASE) for p in routine.params]
+            skip = (MotionStmt, FastMotion, LinRows, Decl)
+            texts = (
+                self.sources.snippet(s.span)
+                for s in statements(routine.body)
+                if not isinstance(s, skip)
+            )
+            found = any(w.search(text) for text in texts for w in words)
+            self.ctx.reads_params[key] = found
+        return found
+
+    def _generic_body(self, routine: Routine, stmt: CallStmt) -> tuple[ir.Node, ...] | None:
+        """The routine lowered at this call with its parameters unknown (what its text says
+        without this call's values), or None where olp cannot lower it so: one routine text
+        for calls whose values differ (:mod:`olp.frontends.krl.routines`)."""
+        if self.generic:
+            return None
+        probe = self._snapshot()
+        probe.generic = True
+        try:
+            probe._inline(routine, stmt)
+        except ParseError:
+            return None
+        pending = probe.out[-1]
+        assert isinstance(pending, PendingCall)
+        return pending.body
 
     def _bind_params(self, routine: Routine, stmt: CallStmt) -> dict[str, Value]:
         """Parameters by value where the arguments are constant; others are unknown inside."""
         bound: dict[str, Value] = {}
         for i, param in enumerate(routine.params):
             arg = stmt.args[i] if i < len(stmt.args) else None
+            if self.generic:
+                bound[param.name.upper()] = Unknown(
+                    f"{param.name} is a parameter of {routine.name}"
+                )
+                continue
             if arg is None:
                 where = stmt.span.location
                 bound[param.name.upper()] = Unknown(
@@ -522,6 +576,7 @@ class _Lowering(Motions, Events):
         child.loops = [*self.loops, "block"] if loop else list(self.loops)
         child.ambiguous = dict(self.ambiguous)
         child.routine = self.routine
+        child.defining, child.generic = self.defining, self.generic
         child.in_block = self.in_block + 1
         if not probe:
             child.ignored, child.notes, child.status_turn = (
@@ -651,6 +706,10 @@ class _Lowering(Motions, Events):
         probe.lower_body(body)
         self.routine.first_pass = probe.routine.back_states
 
+    def _return(self, stmt: Other) -> None:
+        value = None if stmt.value is None else self._expr(stmt.value)
+        self.out.append(ir.Return(value=value, span=stmt.span))
+
     def _snapshot(self) -> _Lowering:
         snap = self._child(probe=True)
         snap.in_block = self.in_block
@@ -664,7 +723,7 @@ class _Lowering(Motions, Events):
                 self.variables.assign(name, Unknown(f"{name} depends on the path through {where}"))
 
     def _other(self, stmt: Other) -> None:
-        routine = self.call_stack[-1] if self.call_stack else "the program"
+        routine = self.call_stack[-1] if self.call_stack else self.defining or "the program"
         if stmt.kind == "GOTO":
             self._goto(stmt)
         elif stmt.kind == "label":
@@ -672,16 +731,18 @@ class _Lowering(Motions, Events):
         elif stmt.kind == "RETURN" and self.in_block:
             if self.call_stack:
                 raise self._error(
-                    f"RETURN inside a block of {routine}: olp inlines calls and cannot inline a "
-                    "routine that returns from inside a block",
+                    f"RETURN inside a block of {routine}: olp lowers a routine at each call and "
+                    "cannot yet follow one that returns from inside a block",
                     stmt.span,
                 )
-            self.out.append(ir.Return(span=stmt.span))
+            self._return(stmt)
             self.returned = (routine, stmt.span.line)
         elif stmt.kind == "RETURN":
             self.returned = (routine, stmt.span.line)
-            where = "ends the program" if not self.call_stack else f"returns from {routine}"
-            self._ignore(stmt, f"RETURN {where} here")
+            if self.call_stack or self.defining:
+                self._return(stmt)
+            else:
+                self._ignore(stmt, "RETURN ends the program here")
         elif stmt.kind == "EXIT" and self.loops and self.loops[-1] == "block":
             self.out.append(ir.Exit(span=stmt.span))
             self.exiting = stmt.span.line
@@ -728,45 +789,35 @@ def lower_module(
     config: KrlData | None,
     shared: Sequence[KrlData] = (),
 ) -> KrlResult:
-    """Lower the first DEF of ``module``; the other routines are inlined where called.
+    """Lower the first DEF of ``module`` and the module's other routines: each called one at
+    every call, kept as a routine where the calls agree (:mod:`olp.frontends.krl.routines`).
     ``shared``: other modules' data lists whose GLOBAL names the module sees
     (:func:`~olp.frontends.krl.data.visible_globals`)."""
     routines = _routines(module, sources, src)
     values = visible_globals(config, shared, dat)
     data = [d for d in (config, *shared, dat) if d is not None]
-    if not any(r.kind == "DEF" for r in routines):
-        return _functions_only(routines, sources, src, dat, config, data)
-    main = next(r for r in routines if r.kind == "DEF")
-    routines = [main, *(r for r in routines if r is not main)]
-    table = {r.name.upper(): r for r in routines}
+    main = next((r for r in routines if r.kind == "DEF"), None)
+    ordered = routines if main is None else [main, *(r for r in routines if r is not main)]
+    table = {r.name.upper(): r for r in ordered}
     ctx = Context(sources, table, src, dat, config, MAX_LOWERED_STATEMENTS, shared)
-    variables = Variables(values, ctx.unknown_name)
-    variables.push(
-        {
-            p.name.upper(): Unknown(f"{p.name} is a parameter of the program; olp does not know it")
-            for p in main.params
-        }
+    lowering = _Lowering(ctx, State(), _variables(values, ctx, main))
+    if main is not None:
+        lowering.routine = RoutineJumps.of(main.body)
+        ctx.called.add(main.name.upper())
+        lowering.first_pass(main.body)
+        lowering.lower_body(main.body)
+    alone = _lower_alone(ordered[1:] if main is not None else ordered, lowering, values)
+    body = build_instructions(lowering.out)
+    assembled = assemble(body, alone, {k: v for k, v in table.items() if v is not main}, sources)
+    ignored = sorted(
+        [*lowering.ignored, *assembled.ignored], key=lambda i: (i.span.line, i.span.column)
     )
-    lowering = _Lowering(ctx, State(), variables)
-    lowering.routine = RoutineJumps.of(main.body)
-    ctx.called.add(main.name.upper())
-    lowering.first_pass(main.body)
-    lowering.lower_body(main.body)
-    for other in routines[1:]:
-        if other.name.upper() not in ctx.called:
-            what = "is never called" if other.kind == "DEF" else "is a function (not lowered)"
-            reason = f"{other.kind} {other.name} {what}"
-            runs_as = ctx.handlers.get(other.name.upper())
-            if runs_as is not None:
-                reason = (
-                    f"DEF {other.name} runs from the {runs_as}; olp does not write routines, so "
-                    "the written program calls a routine it does not hold"
-                )
-            lowering.ignored.append(IgnoredLine(other.span, sources.snippet(other.span), reason))
-    ignored = sorted(lowering.ignored, key=lambda i: (i.span.line, i.span.column))
     for data_list in (dat, config):
         ignored.extend(data_list.ignored if data_list is not None else ())
-    program = ir.Program(name=main.name, instructions=build_instructions(lowering.out), source=src)
+    name = main.name if main is not None else _module_name(src, routines)
+    program = ir.Program(
+        name=name, instructions=assembled.instructions, source=src, routines=assembled.routines
+    )
     program = with_module_data(program, dat, config, shared)
     return KrlResult(
         program=program,
@@ -775,6 +826,70 @@ def lower_module(
         status_turn=tuple(lowering.status_turn),
         data_sources=tuple(d.filename for d in data),
     )
+
+
+def _variables(values: Any, ctx: Context, main: Routine | None) -> Variables:
+    variables = Variables(values, ctx.unknown_name)
+    params = () if main is None else main.params
+    variables.push(
+        {
+            p.name.upper(): Unknown(f"{p.name} is a parameter of the program; olp does not know it")
+            for p in params
+        }
+    )
+    return variables
+
+
+def _lower_alone(
+    routines: Sequence[Routine], main: _Lowering, values: Any
+) -> dict[str, tuple[ir.Node, ...]]:
+    """The routines no call of the program reaches (interrupt handlers, functions, routines
+    never called), each lowered on its own: upper-case name -> body. One that olp cannot
+    lower, or that moves the robot (where it runs from is unknown, so its motions could not
+    be checked), is reported and left out."""
+    ctx = main.ctx
+    bodies: dict[str, tuple[ir.Node, ...]] = {}
+    for routine in routines:
+        if routine.name.upper() in ctx.called:
+            continue
+        lowering = _Lowering(ctx, State(), Variables(values, ctx.unknown_name))
+        lowering.variables.push(
+            {
+                p.name.upper(): Unknown(f"{p.name} is a parameter of {routine.name}")
+                for p in routine.params
+            }
+        )
+        lowering.defining = routine.name
+        lowering.ignored, lowering.notes = main.ignored, main.notes
+        lowering.status_turn, lowering._reported = main.status_turn, main._reported
+        lowering.routine = RoutineJumps.of(routine.body)
+        reason = None
+        try:
+            lowering.first_pass(routine.body)
+            lowering.lower_body(routine.body)
+            body = build_instructions(lowering.out)
+        except ParseError as exc:
+            reason = f"olp cannot lower it: {exc.message}"
+        else:
+            if moves(body):
+                reason = (
+                    "it moves the robot, and olp checks motions only where the program calls them"
+                )
+        if reason is None:
+            bodies[routine.name.upper()] = body
+            continue
+        runs_as = ctx.handlers.get(routine.name.upper())
+        what = f"runs from the {runs_as}" if runs_as is not None else "is never called"
+        if routine.kind == "DEFFCT":
+            what = "is a function the program does not call" if runs_as is None else what
+        main.ignored.append(
+            IgnoredLine(
+                routine.span,
+                ctx.sources.snippet(routine.span),
+                f"{routine.kind} {routine.name} {what} and is not written: {reason}",
+            )
+        )
+    return bodies
 
 
 def _routines(module: Module, sources: SourceSet, src: str) -> list[Routine]:
@@ -796,36 +911,6 @@ def _routines(module: Module, sources: SourceSet, src: str) -> list[Routine]:
             raise sources.error(f"{routine.kind} {routine.name} is defined twice", routine.span)
         seen.add(routine.name.upper())
     return routines
-
-
-def _functions_only(
-    routines: list[Routine],
-    sources: SourceSet,
-    src: str,
-    dat: KrlData | None,
-    config: KrlData | None,
-    data: list[KrlData],
-) -> KrlResult:
-    """A module of functions only (a library of DEFFCTs, called from other modules): there is no
-    program to run, so the program is empty and every function is reported as not lowered."""
-    names = ", ".join(r.name for r in routines)
-    ignored = [
-        IgnoredLine(
-            r.span,
-            sources.snippet(r.span),
-            f"the module holds only functions ({names}) and no DEF to run; olp does not lower "
-            "functions yet",
-        )
-        for r in routines
-    ]
-    for data_list in (dat, config):
-        ignored.extend(data_list.ignored if data_list is not None else ())
-    name = os.path.splitext(os.path.basename(src))[0] or routines[0].name
-    return KrlResult(
-        program=ir.Program(name=name, instructions=(), source=src),
-        ignored=tuple(ignored),
-        data_sources=tuple(d.filename for d in data),
-    )
 
 
 def _count_assign(stmt: ForLoop, count: int) -> ir.Assign:
@@ -857,3 +942,9 @@ def reads_name(nodes: Sequence[Any], name: str) -> bool:
         elif dataclasses.is_dataclass(node) and not isinstance(node, ir.SourceSpan):
             pending.extend(getattr(node, f.name) for f in dataclasses.fields(node))
     return False
+
+
+def _module_name(src: str, routines: Sequence[Routine]) -> str:
+    """A module of functions only (a library of DEFFCTs called from other modules) has no
+    program to run: its program is empty and named after the file."""
+    return os.path.splitext(os.path.basename(src))[0] or routines[0].name

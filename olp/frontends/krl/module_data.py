@@ -16,6 +16,7 @@ used only as motion targets are not declared: their values are in the motions.
 
 from __future__ import annotations
 
+import dataclasses
 import re
 from collections.abc import Iterable, Iterator, Sequence
 from typing import Any
@@ -36,8 +37,13 @@ def with_module_data(
     config: KrlData | None,
     shared: Sequence[KrlData] = (),
 ) -> ir.Program:
-    """``program`` with a declaration of every data-list variable its statements use first."""
-    used, in_text = _used_names(program.instructions)
+    """``program`` with a declaration of every data-list variable its statements use first
+    (those of its routines too, but for a routine's own parameters and locals)."""
+    routines = program.routines
+    used, in_text = _used_names([*program.instructions, *(n for r in routines for n in r.body)])
+    local = {p.name.upper() for r in routines for p in r.params}
+    local |= {d.name.upper() for r in routines for d in r.declarations}
+    used, in_text = used - local, in_text - local
     if not used and not in_text:
         return program
     declared = {
@@ -57,11 +63,7 @@ def with_module_data(
                 declared.add(name)
     if not added:
         return program
-    return ir.Program(
-        name=program.name,
-        instructions=(*added, *program.instructions),
-        source=program.source,
-    )
+    return dataclasses.replace(program, instructions=(*added, *program.instructions))
 
 
 def _globals(config: KrlData | None, shared: Sequence[KrlData]) -> list[KrlData]:

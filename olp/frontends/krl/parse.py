@@ -198,15 +198,22 @@ class _ToAst(Transformer[Token, Module]):
 
     @_inline
     def routine(
-        self, meta: Meta, _global: Any, name: Token, params: Any, body: tuple[Stmt, ...]
+        self, meta: Meta, is_global: Any, name: Token, params: Any, body: tuple[Stmt, ...]
     ) -> Routine:
-        return Routine("DEF", str(name), params or (), body, self._span(meta))
+        span, exported = self._span(meta), is_global is not None
+        return Routine("DEF", str(name), params or (), body, span, exported)
 
     @_inline
     def function(
-        self, meta: Meta, _global: Any, _type: Any, _dims: Any, name: Token, params: Any, body: Any
+        self, meta: Meta, is_global: Any, type_: Any, dims: Any, name: Token, params: Any, body: Any
     ) -> Routine:
-        return Routine("DEFFCT", str(name), params or (), body, self._span(meta))
+        span, exported = self._span(meta), is_global is not None
+        returns = (str(type_), tuple(dims or ()))
+        return Routine("DEFFCT", str(name), params or (), body, span, exported, *returns)
+
+    @_inline
+    def return_stmt(self, meta: Meta, value: Expr | None) -> Other:
+        return Other("RETURN", self._span(meta), value=value)
 
     def params(self, children: list[Param]) -> tuple[Param, ...]:
         return tuple(children)

@@ -269,6 +269,7 @@ class Context:
         self.routines = routines
         self.called: set[str] = set()
         self.handlers: dict[str, str] = {}  # routine -> "the interrupt at line 12" (never inlined)
+        self.reads_params: dict[str, bool] = {}  # routine -> a statement names a parameter
         self.main = next(iter(routines), "")
         self.budget = self.remaining = budget
         self.config = config

@@ -416,6 +416,7 @@ class _Walk:
         self.assumptions = assumptions
         self.cursor = 0
         self.exits: list[States] = []
+        self.returns: list[States] = []
         self.done: States = {}
         self.notes: dict[tuple[str, int, int], str] = {}
         self.used_loops: set[LoopKey] = set()
@@ -436,6 +437,8 @@ class _Walk:
                 states = self.run([*run, node], states)
                 run = []
                 target = self.exits[-1] if self.exits and isinstance(node, ir.Exit) else self.done
+                if isinstance(node, ir.Return) and self.returns:
+                    target = self.returns[-1]  # leaves the expanded routine, not the program
                 for key, bound in states.items():
                     _merge(target, key, bound)
                 states = {}
@@ -459,6 +462,8 @@ class _Walk:
     def block(self, node: Any, states: States, label: str | None) -> States:
         if isinstance(node, ir.If | ir.Switch):
             return self.choose(node, states)
+        if isinstance(node, ir.Expanded):
+            return self.expanded(node, states)
         counted = self.known.passes(node) if isinstance(node, ir.While | ir.Repeat) else None
         self.known.enter_loop(node)
         passes, by_rule = self.passes(node, label, counted)
@@ -471,6 +476,18 @@ class _Walk:
                 f"known: --assume loop:{node.span.line}=N)"
             )
         return out
+
+    def expanded(self, node: ir.Expanded, states: States) -> States:
+        """A routine's body at its call site; a return inside ends the routine, not the
+        program, and an EXIT inside leaves no loop of the caller."""
+        saved = self.exits
+        self.exits = []
+        self.returns.append({})
+        try:
+            end = self.body(node.body, states)
+        finally:
+            self.exits = saved
+        return _merged(end, self.returns.pop())
 
     # ---- branches
 
@@ -793,7 +810,7 @@ def path_timing_pass(compiled: CompiledProgram, options: BuildOptions) -> Compil
 def _one_path(program: ir.Program) -> bool:
     """Whether the text in order is the program's only path: declarations, assignments and
     waits, but no block, jump, exit or return."""
-    turns = (*BLOCK_TYPES, ir.Goto, ir.Exit, ir.Return)
+    turns = tuple(t for t in (*BLOCK_TYPES, ir.Goto, ir.Exit, ir.Return) if t is not ir.Expanded)
     return not any(isinstance(n, turns) for n in leaves_and_blocks(program.instructions))
 
 
