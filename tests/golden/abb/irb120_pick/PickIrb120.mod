@@ -28,6 +28,7 @@ MODULE PickIrb120
     WaitTime \InPos, 0.200;
     MoveL p7, v500, z10, suction\WObj:=conveyor;
     Gripper_Check;
+    PathAccLim FALSE, FALSE;
     MoveAbsJ p8\NoEOffs, v500, fine, suction;
   ENDPROC
 ENDMODULE

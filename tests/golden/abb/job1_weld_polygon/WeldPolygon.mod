@@ -22,6 +22,7 @@ MODULE WeldPolygon
     MoveJ p2, v250, fine, torch\WObj:=table;
     MoveL p3, v250, fine, torch\WObj:=table;
     SprayOn;
+    PathAccLim FALSE, FALSE;
     MoveL p4, v20, z10, torch\WObj:=table;
     MoveL p5, v20, z10, torch\WObj:=table;
     MoveL p6, v20, z10, torch\WObj:=table;
@@ -29,6 +30,7 @@ MODULE WeldPolygon
     MoveL p8, v20, z10, torch\WObj:=table;
     MoveL p9, v20, fine, torch\WObj:=table;
     SprayOff;
+    PathAccLim FALSE, FALSE;
     MoveL p10, v250, fine, torch\WObj:=table;
     MoveAbsJ p11\NoEOffs, v250, fine, torch;
   ENDPROC
