@@ -9,7 +9,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 import olp
@@ -18,31 +17,12 @@ from olp.passes.pipeline import BuildOptions
 from olp.passes.timing.branches import PathTimes
 from olp.passes.timing.conditions import parse_assumptions
 from olp.station.model import Station
+from tests.passes.flow_programs import lin, program, span, start
 
 REPO = Path(__file__).resolve().parents[2]
-TOOL_FORWARD = np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]])
 IN1 = ir.DigitalInput(index=1)
 TOL = 1e-4  # as in test_branches.py
 BODY_LINES = (4, 5)
-
-
-def span(line: int) -> ir.SourceSpan:
-    return ir.SourceSpan("t.src", line, 3)
-
-
-def pose(y_mm: float, z_mm: float = 300.0) -> np.ndarray:
-    out = np.eye(4)
-    out[:3, :3] = TOOL_FORWARD
-    out[:3, 3] = [0.5, y_mm / 1000, z_mm / 1000]
-    return out
-
-
-def start() -> ir.JointMove:
-    return ir.JointMove(target=ir.CartesianTarget(pose=pose(-400)), span=span(1))
-
-
-def lin(line: int, y_mm: float, z_mm: float = 300.0) -> ir.LinearMove:
-    return ir.LinearMove(target=ir.CartesianTarget(pose=pose(y_mm, z_mm)), span=span(line))
 
 
 BODY = (lin(4, -300, 350), lin(5, -300))
@@ -66,10 +46,6 @@ def declare(var: str, type_name: str = "INT", exported: bool = False) -> ir.Decl
 
 def for_to(stop: ir.Expr, body: tuple[ir.Node, ...] = BODY) -> ir.For:
     return ir.For(variable="i", start=const(1), stop=stop, body=body, span=span(3))
-
-
-def program(*nodes: ir.Node) -> ir.Program:
-    return ir.Program(name="t", instructions=nodes, source="t.src")
 
 
 @pytest.fixture(scope="module")

@@ -16,38 +16,14 @@ from olp.passes.pipeline import BuildOptions
 from olp.passes.timing.conditions import parse_assumptions
 from olp.passes.timing.unroll import MAX_UNROLLED, unroll
 from olp.station.model import Station
+from tests.passes.flow_programs import lin, program, span, start
 
 REPO = Path(__file__).resolve().parents[2]
-TOOL_FORWARD = np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]])
 IN1, IN2 = ir.DigitalInput(index=1), ir.DigitalInput(index=2)
 TOL = 1e-4  # as in test_branches.py
 LOOP_TOL = 2e-3
 """A loop's later passes: the path timing times them from the previous pass's end resolved
 again, the straight program along its own resolution; measured 4e-4 apart on a 3 s square."""
-
-
-def span(line: int) -> ir.SourceSpan:
-    return ir.SourceSpan("t.src", line, 3)
-
-
-def pose(y_mm: float, z_mm: float = 300.0) -> np.ndarray:
-    out = np.eye(4)
-    out[:3, :3] = TOOL_FORWARD
-    out[:3, 3] = [0.5, y_mm / 1000, z_mm / 1000]
-    return out
-
-
-def start() -> ir.JointMove:
-    return ir.JointMove(target=ir.CartesianTarget(pose=pose(-400)), span=span(1))
-
-
-def lin(line: int, y_mm: float, z_mm: float = 300.0, zone_mm: float = 0.0) -> ir.LinearMove:
-    target = ir.CartesianTarget(pose=pose(y_mm, z_mm))
-    return ir.LinearMove(target=target, zone=ir.Zone(zone_mm / 1000), span=span(line))
-
-
-def program(*nodes: ir.Node) -> ir.Program:
-    return ir.Program(name="t", instructions=nodes, source="t.src")
 
 
 def counted(body: tuple[ir.Node, ...], count: int, line: int = 3) -> ir.For:
