@@ -449,13 +449,20 @@ def flow_pad_filter(post: Any, step: Any) -> int:
 
 def initial_value(var: Variable) -> ir.Expr | None:
     """The value a variable starts with: its declaration's, or for a single string of module
-    data the text the data list sets as a whole (KRL ``sMsg[]="Ready"``)."""
+    data the text the data list sets as a whole (KRL ``sMsg[]="Ready"``); a FlowProblem where it
+    is not made of constants (a declaration's value is written where no statement runs)."""
     decl = var.declare
+    start = decl.value
     if var.kind == "string" and not var.dims:
         for indices, value in reversed(decl.elements):
             if all(i is None for i in indices):
-                return value
-    return decl.value
+                start = value
+                break
+    if start is not None and any(
+        isinstance(e, ir.Name | ir.FunctionCall | ir.DigitalInput | ir.Index) for e in walk(start)
+    ):
+        raise FlowProblem(f"the initial value of {decl.name} is not made of constants")
+    return start
 
 
 def element_values(var: Variable, default: str, spell: Callable[[ir.Expr], str]) -> list[str]:
@@ -490,10 +497,8 @@ def assigned_module_data(nodes: Sequence[Any]) -> list[tuple[ir.Declare, Any]]:
         target = node.target if isinstance(node, ir.Assign) else None
         if isinstance(node, ir.PathTrigger) and isinstance(node.action, ir.Assign):
             target = node.action.target
-        names = [node.variable] if isinstance(node, ir.For) else []
-        while isinstance(target, ir.Member | ir.Index):
-            target = target.base
-        names += [target.name] if isinstance(target, ir.Name) else []
+        root = root_name(target)
+        names = [node.variable] if isinstance(node, ir.For) else [root] if root else []
         for name in names:
             decl = module.get(name.casefold())
             if decl is not None and name.casefold() not in found:

@@ -221,11 +221,6 @@ class RapidWriter(FlowWriter):
         value = ""
         start = initial_value(var)
         if start is not None:
-            if any(
-                isinstance(e, ir.Name | ir.FunctionCall | ir.DigitalInput | ir.Index)
-                for e in walk(start)
-            ):
-                raise FlowProblem(f"the initial value of {decl.name} is not made of constants")
             value = " := " + self.expr(start)
         storage = "CONST" if decl.constant else "VAR"
         if decl.scope == "module" and not decl.constant:

@@ -101,7 +101,6 @@ from olp.posts.flow_text import (
     initial_value,
     string_index,
     variable_of,
-    walk,
 )
 from olp.posts.text import NameRule
 
@@ -156,15 +155,7 @@ class UrWriter(FlowWriter):
         if len(var.dims) > 1:
             raise FlowProblem(f"{decl.name} has {len(var.dims)} dimensions; olp writes lists")
         start = initial_value(var)
-        if start is not None:
-            if any(
-                isinstance(e, ir.Name | ir.FunctionCall | ir.DigitalInput | ir.Index)
-                for e in walk(start)
-            ):
-                raise FlowProblem(f"the initial value of {decl.name} is not made of constants")
-            value = self.expr(start)
-        else:
-            value = INITIAL[var.kind]
+        value = self.expr(start) if start is not None else INITIAL[var.kind]
         if var.dims:
             size = constant_int(var.dims[0])
             if size is None or not 0 < size <= MAX_LIST:

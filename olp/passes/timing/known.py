@@ -41,6 +41,7 @@ from olp import ir_flow as f
 from olp.passes.timing.conditions import (
     Environment,
     Value,
+    _base_key,
     _Unknown,
     expression_key,
 )
@@ -202,7 +203,7 @@ class Known:
 
     def _forget(self, target: f.Expr) -> None:
         key = expression_key(target)
-        self._forget_key(key if key is not None else _root_of(target))
+        self._forget_key(key if key is not None else _base_key(target))
 
     def _forget_key(self, key: str | None) -> None:
         if key is None:
@@ -233,12 +234,6 @@ def _root(key: str) -> str:
     """The variable of a key: ``part.kind`` -> ``part``, ``slot[2]`` -> ``slot``."""
     cut = [i for i in (key.find("."), key.find("[")) if i >= 0]
     return key[: min(cut)] if cut else key
-
-
-def _root_of(expr: f.Expr) -> str | None:
-    while isinstance(expr, f.Member | f.Index):
-        expr = expr.base
-    return expr.name.casefold() if isinstance(expr, f.Name) else None
 
 
 def _overlap(a: str, b: str) -> bool:
@@ -277,7 +272,7 @@ def _changed(node: Any) -> str | None:
     """The key an assignment ``node`` changes (its root for an element olp cannot name; None
     for a target olp cannot name at all)."""
     target = _target(node)
-    return None if target is None else expression_key(target) or _root_of(target)
+    return None if target is None else expression_key(target) or _base_key(target)
 
 
 def _calls(node: Any) -> Iterator[Any]:
@@ -325,7 +320,7 @@ def _expression_calls(expr: Any) -> Iterator[f.FunctionCall]:
 def _argument_names(call: Any) -> list[str | None]:
     """The variables a call is given (which it may change, as IN/OUT parameters)."""
     if isinstance(call, f.FunctionCall):
-        return [_root_of(a) for a in call.args if a is not None and _root_of(a) is not None]
+        return [_base_key(a) for a in call.args if a is not None and _base_key(a) is not None]
     if isinstance(call, ir.Call):
         return [_name_of_text(a) for a in call.args if _name_of_text(a) is not None]
     return []
