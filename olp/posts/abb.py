@@ -76,6 +76,8 @@ from olp.posts.flow_text import (
     flow_pad_filter,
     flow_problems,
     jump_problems,
+    uncalled_bodies,
+    undeclared_names,
 )
 from olp.posts.numbers import NumberFormat, Storage
 from olp.posts.rapid_flow import RapidWriter, counter_problems, reference_problems
@@ -621,7 +623,9 @@ class AbbPost(Post):
         extra = [*jump_problems(nodes), *counter_problems(nodes), *reference_problems(nodes, table)]
         writer = self.writer(nodes)
         extra += [found for r in routines for found in writer.routine_problems(r, table)]
-        out: list[Diagnostic] = flow_problems(nodes, writer, extra)
+        undeclared = undeclared_names(nodes, routines, routines_see_main=False)
+        statements = [*nodes, *uncalled_bodies(nodes, routines)]
+        out: list[Diagnostic] = flow_problems(statements, writer, extra, undeclared)
         loads: set[str] = set()
         for index, span, tool in _motion_tools(compiled):
             if tool is None or tool.pose is None or tool.name in loads:

@@ -410,15 +410,21 @@ class FlowWriter:
 
 
 def flow_problems(
-    nodes: Sequence[Any], writer: FlowWriter, extra: Iterable[tuple[Any, str]] = ()
+    nodes: Sequence[Any],
+    writer: FlowWriter,
+    extra: Iterable[tuple[Any, str]] = (),
+    unless_other: Iterable[tuple[Any, str]] = (),
 ) -> list[Diagnostic]:
     """One ``flow`` error per flow statement or block of ``nodes`` that ``writer`` cannot write,
-    on its line, plus the ``extra`` (node, message) pairs a language adds."""
+    on its line, plus the ``extra`` (node, message) pairs a language adds, and each of the
+    ``unless_other`` pairs whose statement ``writer`` finds nothing else wrong with (a name
+    that is not a legal one is said once, not also as undeclared)."""
     found = []
     for node in leaves_and_blocks(nodes):
         if isinstance(node, FLOW_TYPES) and (problem := writer.problem(node)) is not None:
             found.append((node, problem))
     found += list(extra)
+    found += [(node, message) for node, message in unless_other if writer.problem(node) is None]
     language = writer.LANGUAGE
     return [
         Diagnostic(
@@ -504,3 +510,80 @@ def assigned_module_data(nodes: Sequence[Any]) -> list[tuple[ir.Declare, Any]]:
             if decl is not None and name.casefold() not in found:
                 found[name.casefold()] = (decl, node)
     return list(found.values())
+
+
+UNDECLARED_HINT = (
+    "declare it in the program (KRL: DECL in the .src, or in the module's .dat); a variable of "
+    "$config.dat or of another module's data list is the KUKA controller's, which another "
+    "vendor's program cannot refer to"
+)
+"""What would declare a name the program uses without a declaration."""
+EVENT_TYPES = (ir.InterruptDecl, ir.InterruptSwitch, ir.PathTrigger)
+"""Statements a post other than KUKA's does not write (an ``unsupported`` error of their own)."""
+
+
+def undeclared_names(
+    nodes: Sequence[Any],
+    routines: Sequence[ir.Routine],
+    routines_see_main: bool,
+    mapped: Callable[[str], bool] = lambda name: False,
+) -> list[tuple[Any, str]]:
+    """(statement, message) for each statement of the program (``nodes``, the analysis view:
+    a call's expansion is checked as the routine's own body, once) or of one of ``routines``
+    that uses a variable nothing declares: the written text would refer to a name the target
+    language does not know (or, worse, to another module's variable of that name).
+
+    Declared are: the program's declarations (any scope; one of another module's data is an
+    error of its own, :func:`variable_of`), in a routine its parameters and its own
+    declarations, and the program's module data and exported variables (the program's other
+    variables too where ``routines_see_main``: URScript's first-level variables are global,
+    RAPID's entry-routine data is not); FOR counters (RAPID declares its loop variable
+    itself, URScript's while assigns it first); and what ``mapped`` says the post maps to a
+    name of its own. Interrupt and trigger statements are not looked into: a post that does
+    not write them refuses them."""
+    main = [n for n in _own_nodes(nodes) if isinstance(n, ir.Declare)]
+    shared = {d.name.casefold() for d in main if d.scope in ("module", "external") or d.exported}
+    out = _undeclared_in(nodes, {d.name.casefold() for d in main}, "the program", mapped)
+    for routine in routines:
+        own = {p.name.casefold() for p in routine.params}
+        own |= {d.name.casefold() for d in routine.declarations}
+        own |= {n.name.casefold() for n in _own_nodes(routine.body) if isinstance(n, ir.Declare)}
+        seen = own | shared | ({d.name.casefold() for d in main} if routines_see_main else set())
+        out += _undeclared_in(routine.body, seen, f"routine {routine.name}", mapped)
+    return out
+
+
+def _own_nodes(nodes: Iterable[Any]) -> Iterator[Any]:
+    """Every node of ``nodes``, blocks included, but not the bodies of call expansions."""
+    for node in nodes:
+        yield node
+        if isinstance(node, BLOCK_TYPES) and not isinstance(node, ir.Expanded):
+            for body in bodies(node):
+                yield from _own_nodes(body)
+
+
+def _undeclared_in(
+    nodes: Sequence[Any], declared: set[str], where: str, mapped: Callable[[str], bool]
+) -> list[tuple[Any, str]]:
+    own = list(_own_nodes(nodes))
+    counters = {n.variable.casefold() for n in own if isinstance(n, ir.For)}
+    out: list[tuple[Any, str]] = []
+    for node in own:
+        if isinstance(node, EVENT_TYPES):
+            continue
+        for name in names_of(node):
+            key = name.casefold()
+            if key in declared or key in counters or mapped(name):
+                continue
+            message = f"{name} is not declared in {where}: {UNDECLARED_HINT}"
+            out.append((node, message))
+            break
+    return out
+
+
+def uncalled_bodies(nodes: Sequence[Any], routines: Sequence[ir.Routine]) -> list[Any]:
+    """The bodies' nodes of the ``routines`` no call in ``nodes`` (the analysis view) expands
+    (a function, an interrupt handler): written all the same, so checked all the same."""
+    expanded = (n for n in leaves_and_blocks(nodes) if isinstance(n, ir.Expanded))
+    called = {n.call.name.casefold() for n in expanded}
+    return [n for r in routines if r.name.casefold() not in called for n in r.body]

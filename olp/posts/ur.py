@@ -85,6 +85,8 @@ from olp.posts.flow_text import (
     flow_lines_filter,
     flow_pad_filter,
     flow_problems,
+    uncalled_bodies,
+    undeclared_names,
 )
 from olp.posts.numbers import NumberFormat
 from olp.posts.rows import PostRows, number_column
@@ -482,7 +484,9 @@ class UrPost(Post):
         own = [n for r in routines for n in (*_param_declarations(r), *r.declarations)]
         writer = self.writer([*own, *nodes])
         extra = [found for r in routines for found in writer.routine_problems(r)]
-        found = flow_problems(nodes, writer, extra) + arc_blends(compiled)
+        undeclared = undeclared_names(nodes, routines, routines_see_main=True)
+        statements = [*nodes, *uncalled_bodies(nodes, routines)]
+        found = flow_problems(statements, writer, extra, undeclared) + arc_blends(compiled)
         found += [
             Diagnostic(
                 "warning",
