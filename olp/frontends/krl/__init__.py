@@ -108,8 +108,9 @@ What is lowered
   and :data:`~olp.frontends.krl.lower.MAX_LOWERED_STATEMENTS` statements in all); others are a
   :class:`~olp.ir.For` block. A jump back to a label makes the variables the routine assigns
   unknown there; one with other motion settings than the label had is an error. ``SPLINE ...
-  ENDSPLINE`` blocks are rejected. ``RETURN`` inside a block of a called routine is rejected
-  (olp lowers it at each call).
+  ENDSPLINE`` blocks are rejected. ``RETURN`` inside a block of a called routine ends that
+  path of the routine (:class:`~olp.ir.Return`); the caller goes on from the join of the
+  routine's end and its RETURNs.
 * **Motions to where the robot is** (``PTP $POS_ACT``, ``PTP $AXIS_ACT``: the block
   coincidence run) are kept as written (:class:`olp.ir.Verbatim`): there is nothing to check.
   A motion to a value derived from them at run time (``lNow.Z = lNow.Z + 100``, ``LIN lNow``)

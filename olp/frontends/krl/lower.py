@@ -142,6 +142,7 @@ class _Lowering(Motions, Events):
         self.routine = RoutineJumps()
         self.defining: str | None = None  # a routine lowered on its own (no call reaches it)
         self.generic = False  # lowering a called routine with its parameters unknown
+        self.return_ends: list[_Lowering] = []  # the states at the RETURNs in blocks of a call
         self._blocks: dict[str, Callable[[Block], None]] = {
             "IF": self._if,
             "SWITCH": self._switch,
@@ -304,18 +305,20 @@ class _Lowering(Motions, Events):
         self.call_stack.append(name)
         self.variables.push(bound)
         saved = self.returned, self.exiting, self.loop_depth, self.loops, self.routine, self.jumped
+        saved_ends, self.return_ends = self.return_ends, []
         self.returned, self.exiting, self.loop_depth, self.loops = None, None, 0, []
         self.routine, self.jumped = RoutineJumps.of(routine.body), None
         caller_out, self.out = self.out, []
         try:
             self.first_pass(routine.body)
             self.lower_body(routine.body)
+            self._join_returns(routine)
         finally:
             lowered, self.out = self.out, caller_out
             finals = self.variables.pop()
             self.call_stack.pop()
             self.returned, self.exiting, self.loop_depth, self.loops, self.routine = saved[:5]
-            self.jumped = saved[5]
+            self.jumped, self.return_ends = saved[5], saved_ends
         self._write_back(routine, stmt, bound, finals)
         args = tuple(to_expr(arg, self._input_index) for arg in stmt.args)
         call = ir.RoutineCall(name=routine.name, args=args, span=stmt.span)
@@ -323,6 +326,17 @@ class _Lowering(Motions, Events):
         generic = self._generic_body(routine, stmt) if self._reads_params(routine) else None
         pending = PendingCall(call=call, body=body, generic=generic, span=stmt.span)
         self.out.append(pending)  # type: ignore[arg-type]  # made a call by routines.assemble
+
+    def _join_returns(self, routine: Routine) -> None:
+        """After a called routine's body: the caller goes on from its end or from any RETURN
+        in a block, so what those paths agree on is known there, and the rest is not (a
+        motion setting that differs is an error at the caller's next motion)."""
+        if not self.return_ends:
+            return
+        ends = [*([] if self.jumped is not None else [self]), *self.return_ends]
+        where = f"the RETURNs of {routine.name}"
+        self._merge_states(ends, where)
+        self._join_variables(ends, where)
 
     def _reads_params(self, routine: Routine) -> bool:
         """Whether a statement of ``routine`` other than a motion or a declaration names one of
@@ -577,6 +591,7 @@ class _Lowering(Motions, Events):
         child.ambiguous = dict(self.ambiguous)
         child.routine = self.routine
         child.defining, child.generic = self.defining, self.generic
+        child.return_ends = [] if probe else self.return_ends
         child.in_block = self.in_block + 1
         if not probe:
             child.ignored, child.notes, child.status_turn = (
@@ -729,13 +744,9 @@ class _Lowering(Motions, Events):
         elif stmt.kind == "label":
             self._label(stmt)
         elif stmt.kind == "RETURN" and self.in_block:
-            if self.call_stack:
-                raise self._error(
-                    f"RETURN inside a block of {routine}: olp lowers a routine at each call and "
-                    "cannot yet follow one that returns from inside a block",
-                    stmt.span,
-                )
             self._return(stmt)
+            if self.call_stack:  # the caller goes on from here too: its state joins there
+                self.return_ends.append(self._snapshot())
             self.returned = (routine, stmt.span.line)
         elif stmt.kind == "RETURN":
             self.returned = (routine, stmt.span.line)

@@ -107,6 +107,7 @@ def assemble(
             if node.call.name.upper() in kept:
                 return [node.call]
             # Written out in place: its own RETURN ends the routine, not the caller.
+            _refuse_nested_return(node, table[node.call.name.upper()], sources)
             return [n for n in resolve(node.body) if not isinstance(n, ir.Return)]
 
         return map_leaves(nodes, edit)
@@ -117,6 +118,23 @@ def assemble(
         if name in bodies
     )
     return Assembled(resolve(main), routines, ignored)
+
+
+def _refuse_nested_return(node: PendingCall, routine: Routine, sources: SourceSet) -> None:
+    """A RETURN inside a block of a routine written out at its calls would end the caller
+    there (a RETURN on the body's own level, last, is dropped): a located error."""
+    top = {id(n) for n in node.body if isinstance(n, ir.Return)}
+    returns = (n for n in leaves(node.body) if isinstance(n, ir.Return) and id(n) not in top)
+    nested = next(returns, None)
+    if nested is not None:
+        raise sources.error(
+            f"RETURN inside a block of {routine.name}, which olp writes out at each of its "
+            "calls (one routine text cannot say what every call does): written out, the RETURN "
+            "would end the caller",
+            nested.span,
+            "make the calls agree (the same targets and motion settings at each call), or "
+            "end the routine without a RETURN in a block",
+        )
 
 
 def _first_difference(calls: Sequence[PendingCall]) -> tuple[Any, PendingCall, PendingCall] | None:

@@ -417,6 +417,7 @@ class _Walk:
         self.cursor = 0
         self.exits: list[States] = []
         self.returns: list[States] = []
+        self.returned: list[list[dict[str, Any]]] = []  # the known values at each return
         self.done: States = {}
         self.notes: dict[tuple[str, int, int], str] = {}
         self.used_loops: set[LoopKey] = set()
@@ -439,6 +440,7 @@ class _Walk:
                 target = self.exits[-1] if self.exits and isinstance(node, ir.Exit) else self.done
                 if isinstance(node, ir.Return) and self.returns:
                     target = self.returns[-1]  # leaves the expanded routine, not the program
+                    self.returned[-1].append(self.known.snapshot())
                 for key, bound in states.items():
                     _merge(target, key, bound)
                 states = {}
@@ -483,10 +485,15 @@ class _Walk:
         saved = self.exits
         self.exits = []
         self.returns.append({})
+        self.returned.append([])
         try:
             end = self.body(node.body, states)
         finally:
             self.exits = saved
+        # The caller goes on from the routine's end or from any return: it knows what all agree on.
+        returned = self.returned.pop()
+        if returned:
+            self.known.join([self.known.snapshot(), *returned])
         return _merged(end, self.returns.pop())
 
     # ---- branches

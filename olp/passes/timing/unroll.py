@@ -5,7 +5,8 @@ branches).
 The path is the one :mod:`.branches` times when every choice is decided (by ``--assume``, by
 constants, or by the program's own assignments, :mod:`.known`): each ``IF``/``SWITCH`` takes
 its one arm, each loop runs the passes the walk counts (a loop whose count olp does not know
-runs one pass, as there), ``EXIT`` leaves the innermost loop, ``RETURN`` ends the program.
+runs one pass, as there), ``EXIT`` leaves the innermost loop, ``RETURN`` ends the routine
+it is in (the call's expansion), or the program in the program's own body.
 Flow statements (declarations, assignments, labels) take no time and are left out. As in the
 path timing, **a blend across a block boundary is an exact stop**: the last motion before
 entering or leaving a block's body (an arm, a loop pass) is made a fine stop, so the straight
@@ -96,6 +97,9 @@ class _Unroll:
         return None
 
     def block(self, node: Any, label: str | None) -> str | None:
+        if isinstance(node, ir.Expanded):
+            self.body(node.body)  # a RETURN inside ends the routine, and the caller goes on
+            return None
         if isinstance(node, ir.If | ir.Switch):
             env = self.known.environment()
             arms = if_arms(node, env) if isinstance(node, ir.If) else case_arms(node, env)
