@@ -10,8 +10,12 @@ with a constant ``n``, and a one-bit SIGNAL of an input, become :class:`olp.ir.D
 
 from __future__ import annotations
 
+import dataclasses
 import math
-from collections.abc import Callable, Iterable, Iterator
+import re
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from dataclasses import dataclass
+from typing import Any
 
 from olp import ir
 from olp.frontends.krl.ast import (
@@ -34,6 +38,7 @@ from olp.frontends.krl.ast import (
     Unary,
     Var,
 )
+from olp.frontends.krl.values import Unknown, Value
 
 _BINARY = {
     "AND": "and",
@@ -137,3 +142,55 @@ def is_straight(body: Iterable[Stmt]) -> bool:
         if isinstance(stmt, Other) and stmt.kind in ("GOTO", "label"):
             return False
     return True
+
+
+# ------------------------------------------------------------------------------------------------
+# The counter of a FOR loop olp unrolled, after the loop
+
+
+@dataclass(frozen=True, slots=True)
+class PastFor(Unknown):
+    """The value of a FOR counter after the loop olp wrote out pass by pass (``line``: the
+    FOR's). The passes write ``counter = n`` only where they read it; what KRL leaves in the
+    counter after the loop (one step past the end value, as olp recalls the KSS manual; not
+    verified against a stored copy, nor what a loop left by EXIT or run zero times leaves) is
+    not written. So a statement after the loop that reads the counter is an error rather than
+    a text that reads another value on the controller."""
+
+    line: int = 0
+    name: str = ""
+
+
+def past_for(name: str, line: int) -> PastFor:
+    reason = f"olp does not track {name} after its FOR loop (line {line})"
+    return PastFor(reason, line=line, name=name)
+
+
+def joined(values: Sequence[Value], reason: str) -> Value:
+    """The value after paths that disagree: unknown, and still a counter past its unrolled FOR
+    (:class:`PastFor`) where one path leaves it so: reading it is then an error on every path."""
+    past = next((v for v in values if isinstance(v, PastFor)), None)
+    return past if past is not None else Unknown(reason)
+
+
+def reads_value(nodes: Sequence[Any], name: str) -> bool:
+    """Whether lowered ``nodes`` read the variable ``name`` (an assignment to it as a whole
+    writes it, not reads it): a :class:`ir.Name` in any expression, or the word in a statement
+    kept as text (a verbatim line, a call's arguments)."""
+    word = re.compile(rf"(?<![\w$]){re.escape(name)}(?![\w$])", re.IGNORECASE)
+    pending: list[Any] = [
+        n.value if isinstance(n, ir.Assign) and isinstance(n.target, ir.Name) else n for n in nodes
+    ]
+    while pending:
+        node = pending.pop()
+        if isinstance(node, ir.Name):
+            if node.name.upper() == name.upper():
+                return True
+        elif isinstance(node, str):
+            if word.search(node):
+                return True
+        elif isinstance(node, tuple | list):
+            pending.extend(node)
+        elif dataclasses.is_dataclass(node) and not isinstance(node, ir.SourceSpan):
+            pending.extend(getattr(node, f.name) for f in dataclasses.fields(node))
+    return False

@@ -47,7 +47,17 @@ from olp.frontends.krl.ast import (
 )
 from olp.frontends.krl.data import OTHER_REASONS, KrlData, visible_globals
 from olp.frontends.krl.events import Events
-from olp.frontends.krl.flow import assigned_names, is_straight, jump_targets, statements, to_expr
+from olp.frontends.krl.flow import (
+    PastFor,
+    assigned_names,
+    is_straight,
+    joined,
+    jump_targets,
+    past_for,
+    reads_value,
+    statements,
+    to_expr,
+)
 from olp.frontends.krl.module_data import with_module_data
 from olp.frontends.krl.motion import Motions
 from olp.frontends.krl.routines import PendingCall, assemble, moves
@@ -143,6 +153,7 @@ class _Lowering(Motions, Events):
         self.defining: str | None = None  # a routine lowered on its own (no call reaches it)
         self.generic = False  # lowering a called routine with its parameters unknown
         self.return_ends: list[_Lowering] = []  # the states at the RETURNs in blocks of a call
+        self.past: set[str] = set()  # counters of unrolled FOR loops (see flow.PastFor)
         self._blocks: dict[str, Callable[[Block], None]] = {
             "IF": self._if,
             "SWITCH": self._switch,
@@ -209,10 +220,37 @@ class _Lowering(Motions, Events):
                 hint="set them again before the motion (the pendant's inline forms do)",
             )
         self.ctx.spend(stmt)
+        past = self._past_counters(stmt)
+        start = len(self.out)
         try:
             self._statements[type(stmt)](stmt)
         except ir.IRError as exc:
             raise self._error(f"invalid value: {exc}", stmt.span) from None
+        if past:
+            self._no_read_past_for(past, start, stmt)
+
+    def _past_counters(self, stmt: Stmt) -> dict[str, PastFor]:
+        """The counters of unrolled FOR loops that hold their value after the loop here
+        (a block's and a FOR's statements are checked one by one as they are lowered)."""
+        if not self.past or isinstance(stmt, Block | ForLoop):
+            return {}
+        values = {name: self.variables.lookup(name) for name in self.past}
+        return {name: v for name, v in values.items() if isinstance(v, PastFor)}
+
+    def _no_read_past_for(self, past: dict[str, PastFor], start: int, stmt: Stmt) -> None:
+        nodes = [n.call if isinstance(n, PendingCall) else n for n in self.out[start:]]
+        for key, value in sorted(past.items()):
+            if reads_value(nodes, key):
+                name = value.name or key
+                raise self._error(
+                    f"{name} is read after the FOR loop at line {value.line}, which olp writes "
+                    "out pass by pass: the value KRL leaves in the counter after the loop is not "
+                    "written (olp has not verified it against a KUKA manual), so the controller "
+                    "would read another",
+                    stmt.span,
+                    hint=f"use another variable for what the loop leaves, or give {name} a "
+                    "value before reading it",
+                )
 
     # ---- motions to where the robot is
     def _motion_or_here(self, stmt: MotionStmt) -> None:
@@ -516,12 +554,8 @@ class _Lowering(Motions, Events):
         finally:
             self.loop_depth -= 1
             self.loops.pop()
-        self.variables.assign(
-            counter,
-            Unknown(
-                f"olp does not track {stmt.counter} after its FOR loop (line {stmt.span.line})"
-            ),
-        )
+        self.variables.assign(counter, past_for(stmt.counter, stmt.span.line))
+        self.past.add(counter)
 
     def _for_block(self, stmt: ForLoop) -> None:
         counter = stmt.counter.upper()
@@ -592,6 +626,7 @@ class _Lowering(Motions, Events):
         child.routine = self.routine
         child.defining, child.generic = self.defining, self.generic
         child.return_ends = [] if probe else self.return_ends
+        child.past = self.past
         child.in_block = self.in_block + 1
         if not probe:
             child.ignored, child.notes, child.status_turn = (
@@ -616,7 +651,8 @@ class _Lowering(Motions, Events):
         probe.lower_body(body)
         where = f"the {keyword} at line {span.line}"
         for name in sorted(probe.variables.changed_since(self.variables)):
-            self.variables.assign(name, Unknown(f"{name} may be changed by a pass of {where}"))
+            reason = f"{name} may be changed by a pass of {where}"
+            self.variables.assign(name, joined([probe.variables.lookup(name)], reason))
         self._merge_states([self, probe], where)
         child, lowered = self._branch(body, loop=True)
         self._join([child], keyword, span, fallthrough=True)
@@ -645,7 +681,8 @@ class _Lowering(Motions, Events):
             if all(v is values[0] or v == values[0] for v in values):
                 self.variables.assign(name, values[0])
             else:
-                self.variables.assign(name, Unknown(f"{name} depends on the path through {where}"))
+                reason = f"{name} depends on the path through {where}"
+                self.variables.assign(name, joined(values, reason))
         self._merge_states(reached, where)
 
     def _merge_states(self, ends: Sequence[_Lowering], where: str) -> None:
@@ -735,7 +772,8 @@ class _Lowering(Motions, Events):
         for name in sorted(changed):
             values = [e.variables.lookup(name) for e in ends]
             if not all(v is values[0] or v == values[0] for v in values):
-                self.variables.assign(name, Unknown(f"{name} depends on the path through {where}"))
+                reason = f"{name} depends on the path through {where}"
+                self.variables.assign(name, joined(values, reason))
 
     def _other(self, stmt: Other) -> None:
         routine = self.call_stack[-1] if self.call_stack else self.defining or "the program"
