@@ -277,3 +277,25 @@ def test_written_out_locals_may_not_share_a_name(station: Any, tmp_path: Path) -
     assert error.span is not None and error.span.line == 8
     assert "same variable as the program's" in error.message
     assert build(station, path, "kuka").ok
+
+
+def test_named_points_of_the_routines_are_in_the_dat(station: Any, tmp_path: Path) -> None:
+    """``points: dat``: a routine's motions refer to named points, which the module's data list
+    (shared by every DEF of the module) must declare like the main program's; before, the
+    routines' points were declared nowhere and the module did not compile. Every name a
+    motion uses is declared once, and a routine's point holds its first call's values."""
+    from olp.posts import find_post
+
+    folder = tmp_path / "named"
+    shutil.copytree(find_post("kuka").manifest.folder, folder)
+    manifest = folder / "post.yaml"
+    manifest.write_text(manifest.read_text().replace("points: inline", "points: dat"))
+    result = olp.build(station, PALLETISE, post=str(folder), collisions=None)
+    assert result.ok, [d.format() for d in result.diagnostics if d.severity == "error"]
+    src, dat = (result.files[f"palletise.{ext}"].split("\r\n") for ext in ("src", "dat"))
+    used = [w for line in src for w in line.split() if w.startswith("XP") or w.startswith("XA")]
+    used = [w.rstrip(",") for w in used]
+    declared = [line.split()[2].split("=")[0] for line in dat if line.startswith("DECL E6")]
+    assert sorted(set(used)) == sorted(declared) and len(declared) == len(set(declared))
+    routine_lines = src[src.index("DEF PickPart()") :]
+    assert any(line.startswith(("LIN XP", "PTP XP")) for line in routine_lines)
