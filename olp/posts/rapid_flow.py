@@ -63,6 +63,10 @@ from one run to the next) is a module ``PERS``, written with the data list's val
 elements as a list; RAPID's zero of the type where the list gives none, :data:`PERS_ZERO`).
 RAPID requires a persistent's value in its declaration (RAPID reference, PERS; as recalled).
 A variable of another module's data list is an error: the RAPID program cannot refer to it.
+So is a name the program uses that nothing declares (:func:`olp.posts.flow_text.undeclared_names`:
+a ``$config.dat`` variable, or a routine reading the entry routine's own data, which RAPID
+keeps inside ``PROC main``); routine parameters and locals, module data and FOR counters (RAPID
+declares its loop variable itself) are declared by the program's structure.
 Types (:data:`RAPID_TYPES`): bool,
 ``num`` for INT and REAL (RAPID's num is a 32-bit float, as KRL's REAL; INT values are exact up
 to 2^23 only, so a whole-number constant beyond :data:`NUM_EXACT_INT` is an error rather than

@@ -59,7 +59,9 @@ variable's value. KRL arrays count from 1, URScript lists from 0: ``a[i]`` is wr
 variable) is ``global`` with the data list's value (an array's elements in its list); it starts
 from that value on every run, where the KUKA controller keeps the last run's: the post warns
 for each one the program assigns (:meth:`olp.posts.ur.UrPost.check_program`). A variable of
-another module's data list is an error.
+another module's data list is an error, and so is a name the program uses that nothing declares
+(:func:`olp.posts.flow_text.undeclared_names`; a routine may read the program's first-level
+variables, which are global).
 
 Expressions
 -----------

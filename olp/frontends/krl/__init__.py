@@ -106,7 +106,9 @@ What is lowered
   assigns are unknown inside). ``FOR`` loops with constant integer bounds over straight-line
   code are unrolled (at most :data:`~olp.frontends.krl.lower.MAX_FOR_ITERATIONS` iterations,
   and :data:`~olp.frontends.krl.lower.MAX_LOWERED_STATEMENTS` statements in all); others are a
-  :class:`~olp.ir.For` block. A jump back to a label makes the variables the routine assigns
+  :class:`~olp.ir.For` block; a statement after an unrolled loop that reads its counter is an
+  error (the value KRL leaves in it is not written: :class:`olp.frontends.krl.flow.PastFor`).
+  A jump back to a label makes the variables the routine assigns
   unknown there; one with other motion settings than the label had is an error. ``SPLINE ...
   ENDSPLINE`` blocks are rejected. ``RETURN`` inside a block of a called routine ends that
   path of the routine (:class:`~olp.ir.Return`); the caller goes on from the join of the
