@@ -103,3 +103,55 @@ def test_a_module_of_functions_only_is_written_without_an_empty_program_of_its_n
     again = _read_again(tmp_path, "SpindleRpm.src", written)
     assert [r.name for r in again.routines] == ["SpindleRpm", "Clamp"]
     assert _shape(again) == _shape(program)
+
+
+SETTINGS_MODULE = """\
+&ACCESS RV
+DEF ApplySpeed(nPercent:IN, bSlow:IN)
+   INT nPercent
+   BOOL bSlow
+   IF bSlow THEN
+      $OV_PRO = nPercent / 2
+   ELSE
+      $OV_PRO = nPercent
+   ENDIF
+END
+"""
+
+
+def test_the_programs_own_parameters_are_a_warning_at_its_def_line(
+    station: object, tmp_path: Path
+) -> None:
+    src = tmp_path / "ApplySpeed.src"
+    src.write_text(SETTINGS_MODULE, encoding="latin-1")
+    result = olp.build(station, src, post="kuka", collisions=None)  # type: ignore[arg-type]
+    (said,) = [d for d in result.diagnostics if "program's parameters" in d.message]
+    assert (said.severity, said.kind, said.span.line) == ("warning", "ignored", 2)
+    assert "(nPercent, bSlow) are not kept" in said.message
+
+
+TOOL_SETUP_MODULE = """\
+&ACCESS RV
+DEF ToolSetup( )
+   $VEL.CP = 0.2
+   $APO.CDIS = 5
+   $BASE = {X 500, Y 0, Z 300, A 0, B 0, C 0}
+   $TOOL = {X 0, Y 0, Z 120, A 0, B 0, C 0}
+   LIN {X 100, Y -100, Z 100, A 0, B 90, C 0}
+   $BASE = $NULLFRAME
+   IF $IN[3] THEN
+      $TOOL = $NULLFRAME
+   ENDIF
+END
+"""
+
+
+def test_settings_no_motion_runs_with_are_a_warning_not_a_silent_drop(
+    station: object, tmp_path: Path
+) -> None:
+    src = tmp_path / "ToolSetup.src"
+    src.write_text(TOOL_SETUP_MODULE, encoding="latin-1")
+    result = olp.build(station, src, post="kuka", collisions=None)  # type: ignore[arg-type]
+    lost = [d for d in result.diagnostics if "no motion of the program runs with" in d.message]
+    # the settings before the LIN are written with it; those after it are not written at all
+    assert [(d.severity, d.span.line) for d in lost] == [("warning", 8), ("warning", 10)]
