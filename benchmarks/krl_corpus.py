@@ -31,7 +31,7 @@ reported only at ``info`` level (``silent_drops``: "nothing dropped silently" wa
 the files that build, where each statement of the ``.src`` went: ``kept`` (a node of the
 program's IR carries its line, so the KRL post writes it), ``absorbed`` into the motions' speeds,
 zones, tools and bases (inline-form data, BAS, ``$VEL``/``$ACC``/``$TOOL``/``$BASE``/``$APO``/
-``$ORI_TYPE``), an
+``$ORI_TYPE``) when a motion of the module comes after it, an
 ``inlined`` call of the module's own DEF, ``warned`` (reported as not in the output), or
 ``unaccounted`` (the figure that must be 0: listed). With the KUKA post it also reads the
 written ``.src`` again and compares its statements with the source's, in order
@@ -132,11 +132,21 @@ def account(text: str, src: str, result: object, tally: Tally) -> None:
     """Where every statement of the program went: kept (an IR node has its line), absorbed
     into the motions (inline-form data, BAS, $VEL/$TOOL/... settings), an inlined call, a
     warning, or unaccounted (lost without a word: the figure that must be 0)."""
+    from olp.ir import is_motion
     from olp.ir_flow import leaves_and_blocks
 
     program = result.compiled.program  # type: ignore[attr-defined]
     lines = statement_lines(text)
     kept = {n.span.line for n in leaves_and_blocks(program.instructions) if n.span.file == src}
+    nodes = list(leaves_and_blocks(program.instructions))
+    motions = [n.span.line for n in nodes if is_motion(n) and n.span.file == src]
+    for routine in program.routines:  # the module's routines the program keeps, written out too
+        nodes = [*routine.params, *routine.declarations, *leaves_and_blocks(routine.body)]
+        kept.update(n.span.line for n in nodes if n.span.file == src)
+        motions.extend(n.span.line for n in nodes if is_motion(n) and n.span.file == src)
+    # a setting is in the output only through a motion that runs with it (the posts write
+    # $BASE, $VEL, ... before the motions): one after the module's last motion is lost
+    last_motion = max(motions, default=0)
     warned = {
         d.span.line
         for d in result.diagnostics  # type: ignore[attr-defined]
@@ -146,15 +156,17 @@ def account(text: str, src: str, result: object, tally: Tally) -> None:
         m.group(1).upper() for m in re.finditer(r"(?im)^\s*(?:GLOBAL\s+)?DEF\s+(\w+)", text)
     }
     starts = [n for n, raw in enumerate(text.splitlines(), start=1) if _ROUTINE.match(raw.strip())]
+    # a warning at a routine's head covers its statements only when none of them is written
+    written = {max((s for s in starts if s <= n), default=0) for n in kept}
     for number, line in lines.items():
         head = max((n for n in starts if n <= number), default=0)
-        if head in warned:  # a routine olp does not write (never called, functions only)
+        if head in warned and head not in written:  # a routine olp does not write at all
             warned.add(number)
         call = _CALL.match(line)
         tally.statements_in += 1
         if number in kept:
             tally.kept += 1
-        elif _ABSORBED.match(line):
+        elif _ABSORBED.match(line) and number < last_motion:
             tally.absorbed += 1
         elif call is not None and call.group(1).upper() in routines:
             tally.inlined += 1
@@ -306,7 +318,8 @@ def round_trips(result: object, options: object) -> bool:
         stem = Path(written).stem.lower()
         lists = [d for d in options.data_lists if Path(d.filename).stem.lower() != stem]  # type: ignore[attr-defined]
         again = load_krl(Path(scratch) / written, config, data_lists=lists).program
-    return shape(again) == shape(result.compiled.program)  # type: ignore[attr-defined]
+    # the compiled program is the analysis view (each call holds its routine's body): so is this
+    return shape(again.expanded()) == shape(result.compiled.program)  # type: ignore[attr-defined]
 
 
 def main() -> None:

@@ -100,10 +100,11 @@ def krl_decl(step: Any) -> str:
 def krl_routine_head(routine: ir.Routine) -> str:
     """``[GLOBAL] DEF name(p:IN, q:OUT)`` or ``[GLOBAL] DEFFCT TYPE[dims] name(...)``: an
     ``"in"`` parameter is KRL's ``:IN`` (by value), an ``"out"`` one ``:OUT`` (by reference);
-    an array parameter has empty brackets (``sText[]:IN``). Its type is declared in the body
+    an array parameter has empty brackets, a comma between the positions of one of several
+    dimensions (``sText[]:IN``, ``rMatrix[,]:OUT``). Its type is declared in the body
     (:func:`krl_param_decl`)."""
     params = ", ".join(
-        f"{p.name}{'[]' if p.dims else ''}:{'OUT' if p.by_reference else 'IN'}"
+        f"{p.name}{_empty_index(p.dims)}:{'OUT' if p.by_reference else 'IN'}"
         for p in routine.params
     )
     prefix = "GLOBAL " if routine.exported else ""
@@ -113,6 +114,11 @@ def krl_routine_head(routine: ir.Routine) -> str:
         f"[{','.join(krl_expr(d) for d in routine.returns_dims)}]" if routine.returns_dims else ""
     )
     return f"{prefix}DEFFCT {routine.returns}{dims} {routine.name}({params})"
+
+
+def _empty_index(dims: tuple[object, ...]) -> str:
+    """``[]``, ``[,]``, ... for an array parameter of ``len(dims)`` dimensions, else empty."""
+    return f"[{',' * (len(dims) - 1)}]" if dims else ""
 
 
 def krl_routine_end(routine: ir.Routine) -> str:

@@ -66,6 +66,8 @@ from olp.frontends.krl.state import (
     DEFAULT_VEL_CP,
     Context,
     KrlResult,
+    Pending,
+    PendingRows,
     State,
     is_here,
 )
@@ -78,6 +80,7 @@ from olp.frontends.krl.values import (
     Variables,
     as_int,
 )
+from olp.ir_flow import leaves
 
 __all__ = ["DEFAULT_VEL_CP", "KrlResult", "lower_module"]
 
@@ -154,6 +157,8 @@ class _Lowering(Motions, Events):
         self.generic = False  # lowering a called routine with its parameters unknown
         self.return_ends: list[_Lowering] = []  # the states at the RETURNs in blocks of a call
         self.past: set[str] = set()  # counters of unrolled FOR loops (see flow.PastFor)
+        # statements that set motion settings (absorbed into the motions) since the last motion
+        self.unwritten: list[Stmt] = []
         self._blocks: dict[str, Callable[[Block], None]] = {
             "IF": self._if,
             "SWITCH": self._switch,
@@ -201,6 +206,7 @@ class _Lowering(Motions, Events):
     def lower_statement(self, stmt: Stmt) -> None:
         if isinstance(stmt, LinRows):  # checks and spends per row itself
             self._lin_rows(stmt)
+            self.unwritten.clear()
             return
         if self.returned is not None:
             routine, line = self.returned
@@ -221,13 +227,14 @@ class _Lowering(Motions, Events):
             )
         self.ctx.spend(stmt)
         past = self._past_counters(stmt)
-        start = len(self.out)
+        start, reported = len(self.out), len(self.ignored)
         try:
             self._statements[type(stmt)](stmt)
         except ir.IRError as exc:
             raise self._error(f"invalid value: {exc}", stmt.span) from None
         if past:
             self._no_read_past_for(past, start, stmt)
+        self._track_settings(stmt, self.out[start:], len(self.ignored) > reported)
 
     def _past_counters(self, stmt: Stmt) -> dict[str, PastFor]:
         """The counters of unrolled FOR loops that hold their value after the loop here
@@ -251,6 +258,27 @@ class _Lowering(Motions, Events):
                     hint=f"use another variable for what the loop leaves, or give {name} a "
                     "value before reading it",
                 )
+
+    def _track_settings(self, stmt: Stmt, new: Sequence[Any], reported: bool) -> None:
+        """Note an assignment or call that left nothing in the program and was not reported:
+        one olp absorbed into the motion settings (``$BASE``, ``$VEL.CP``, ``BAS``,
+        ``PDAT_ACT``, ...). The posts write settings before the motions that run with them, so
+        one that no motion follows is not in the output (:meth:`report_unwritten_settings`)."""
+        if moves(new) or any(isinstance(n, Pending | PendingRows) for n in leaves(new)):
+            self.unwritten.clear()
+        elif isinstance(stmt, Assign | CallStmt) and not new and not reported:
+            self.unwritten.append(stmt)
+
+    def report_unwritten_settings(self) -> None:
+        """Warn about the settings no motion of the program follows (a routine that sets
+        ``$BASE`` and ``$TOOL`` for its callers, written as a program of its own)."""
+        for stmt in self.unwritten:
+            self._ignore(
+                stmt,
+                "sets motion settings no motion of the program runs with: olp writes settings "
+                "only before the motions that use them, so this one is not in the output",
+            )
+        self.unwritten.clear()
 
     # ---- motions to where the robot is
     def _motion_or_here(self, stmt: MotionStmt) -> None:
@@ -635,6 +663,7 @@ class _Lowering(Motions, Events):
                 self.status_turn,
             )
             child._reported = self._reported
+            child.unwritten = self.unwritten
         return child
 
     def _branch(self, body: Sequence[Stmt], loop: bool = False) -> tuple[_Lowering, Body]:
@@ -855,11 +884,13 @@ def lower_module(
         ctx.called.add(main.name.upper())
         lowering.first_pass(main.body)
         lowering.lower_body(main.body)
+        lowering.report_unwritten_settings()
     alone = _lower_alone(ordered[1:] if main is not None else ordered, lowering, values)
     body = build_instructions(lowering.out)
     assembled = assemble(body, alone, {k: v for k, v in table.items() if v is not main}, sources)
     ignored = sorted(
-        [*lowering.ignored, *assembled.ignored], key=lambda i: (i.span.line, i.span.column)
+        [*lowering.ignored, *assembled.ignored, *_program_parameters(main, sources)],
+        key=lambda i: (i.span.line, i.span.column),
     )
     for data_list in (dat, config):
         ignored.extend(data_list.ignored if data_list is not None else ())
@@ -875,6 +906,22 @@ def lower_module(
         status_turn=tuple(lowering.status_turn),
         data_sources=tuple(d.filename for d in data),
     )
+
+
+def _program_parameters(main: Routine | None, sources: SourceSet) -> list[IgnoredLine]:
+    """The program's own parameters (``DEF MoveTo(nBase:IN, nTool:IN)``, a module other modules
+    call) are not in the IR's program, which takes none: the written ``DEF`` has empty
+    parentheses and their ``DECL`` lines declare local variables, so a caller's arguments would
+    not reach it. Said at the ``DEF`` line, as a statement not in the output."""
+    if main is None or not main.params:
+        return []
+    names = ", ".join(p.name for p in main.params)
+    span = dataclasses.replace(main.span, end_line=main.span.line, end_column=None)
+    reason = (
+        f"the program's parameters ({names}) are not kept: the written DEF takes none and "
+        "declares them as local variables, so a caller's arguments would not reach it"
+    )
+    return [IgnoredLine(span, sources.snippet(span), reason)]
 
 
 def _variables(values: Any, ctx: Context, main: Routine | None) -> Variables:
@@ -916,6 +963,7 @@ def _lower_alone(
         try:
             lowering.first_pass(routine.body)
             lowering.lower_body(routine.body)
+            lowering.report_unwritten_settings()
             body = build_instructions(lowering.out)
         except ParseError as exc:
             reason = f"olp cannot lower it: {exc.message}"
