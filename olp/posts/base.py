@@ -28,6 +28,9 @@ What every post checks (:meth:`Post.check`), so that no brand can forget it:
   ``call_argument``);
 * digital I/O numbers within the controller's range (``IO_RANGE``, ``io_range``);
 * a station robot of another brand than the post's (a warning, ``foreign_robot``);
+* a motion to a run-time target (:class:`~olp.ir.RuntimeMove`) is written only by a post whose
+  ``KINDS`` hold ``runtime_move``, from a template folder that declares ``runtime_targets:
+  true``; else an error on its line (``runtime_target``);
 * a :class:`~olp.ir.Verbatim` statement of another language than the post's ``VERBATIM`` is an
   error naming its line (``verbatim``); with the post option ``foreign_verbatim: drop`` (in a
   template folder, or ``olp build --drop-foreign-verbatim``) it is left out with a warning
@@ -479,6 +482,8 @@ class Post:
         kind = ins.kind
         if kind == "verbatim":
             return self._verbatim_checks(step, ins)
+        if kind == "runtime_move":
+            return self._runtime_checks(step, ins)
         if kind not in self.KINDS:
             what = kind.replace("_", " ")
             article = "an" if what[:1] in "aeiou" else "a"
@@ -493,6 +498,27 @@ class Post:
         if kind == "circular":
             return self._arc_checks(step, ins)
         return []
+
+    def _runtime_checks(self, step: Step, ins: Any) -> list[Diagnostic]:
+        """A motion to a run-time target: written by a post that can (``"runtime_move"`` in
+        :attr:`KINDS`) from a template folder that says so (``runtime_targets: true``: a copy
+        made before olp wrote them would leave the motion out); a circular one as any arc.
+        What the language can name as a target is the brand's :meth:`check_instruction`."""
+        what = f"a {ins.motion} move to a target known only at run time (line {ins.span.line})"
+        if "runtime_move" not in self.KINDS:
+            msg = f"the {self.LANGUAGE} post cannot write {what}"
+            return [_error("runtime_target", msg, step)]
+        if not self.manifest.runtime_targets:
+            msg = (
+                f"the {self.LANGUAGE} post's template folder {self.manifest.folder.name} does not "
+                f"declare that it writes {what} (runtime_targets: true in its post.yaml)"
+            )
+            hint = (
+                f"use the bundled {self.NAME} post, or copy its templates' run-time motion lines "
+                "and declare runtime_targets: true"
+            )
+            return [_error("runtime_target", msg, step, hint=hint)]
+        return self._arc_checks(step, ins) if ins.motion == "circular" else []
 
     def _arc_checks(self, step: Step, ins: Any) -> list[Diagnostic]:
         """A circular move whose orientation rule or circular angle this language cannot

@@ -561,8 +561,17 @@ def test_home(config: KrlData) -> None:
     np.testing.assert_allclose(first.target.joints, np.radians([0, -90, 90, 0, 30, 0]))
     np.testing.assert_array_equal(first.target.joints, second.target.joints)
     assert "$machine.dat" in parse_error("PTP $H_POS").message
-    error = parse_error("PTP XHOME")
-    assert "XHOME is not declared" in error.message
+
+
+def test_home_without_config_dat_is_a_motion_to_a_run_time_target() -> None:
+    """Every KR C4 ``$config.dat`` declares XHOME; without it olp keeps ``PTP XHOME`` as a
+    motion to a target it does not know (never a guessed home), and the reason names the
+    missing ``$config.dat``. Another undeclared name stays an error."""
+    (home,) = [n for n in parse("PTP XHOME").program if isinstance(n, ir.RuntimeMove)]
+    assert home.motion == "joint" and home.target == ir.Name(name="XHOME", span=home.target.span)
+    assert "$config.dat" in home.reason and "--config-dat" in home.reason
+    error = parse_error("PTP XHOMEX")
+    assert "XHOMEX is not declared" in error.message
     assert error.hint is not None and "config_dat" in error.hint
 
 
