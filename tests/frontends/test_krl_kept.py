@@ -11,7 +11,6 @@ import olp
 from olp import ir
 from olp.frontends.bundled import KrlOptions
 from olp.frontends.krl import load_krl
-from olp.ir_flow import leaves_and_blocks
 
 REPO = Path(__file__).resolve().parents[2]
 STATION = REPO / "stations" / "kr6_milling_cell.yaml"

@@ -23,6 +23,7 @@ BACKUP_CONFIG = REPO / "tests" / "corpus" / "krc" / "R1" / "System" / "$config.d
 CONFIG = REPO / "examples" / "robot_config.dat"
 HOME = "PTP {A1 0,A2 -90,A3 90,A4 0,A5 30,A6 0}"
 FRAMES = ("$BASE = BASE_DATA[1]", "$TOOL = TOOL_DATA[1]")
+LIN = "LIN {X 500,Y 0,Z 400,A 0,B 90,C 0}"
 
 
 @pytest.fixture(scope="module")
