@@ -169,6 +169,9 @@ class Post:
     """The orientation rules of circular moves this language can write (the three-point arc
     interpolating start to end, unless a brand says otherwise); any other is an error on the
     move's line, never a different path."""
+    RUNTIME_REFUSAL: ClassVar[str] = ""
+    """Why the post cannot write motions to run-time targets (``runtime_move`` not in
+    :attr:`KINDS`), for the error on such a motion."""
     ARC_ANGLE: ClassVar[bool] = False
     """Whether a circular move's circular angle (KUKA's CA) can be written."""
     ACCELERATIONS: ClassVar[frozenset[str]] = frozenset()
@@ -506,7 +509,8 @@ class Post:
         What the language can name as a target is the brand's :meth:`check_instruction`."""
         what = f"a {ins.motion} move to a target known only at run time (line {ins.span.line})"
         if "runtime_move" not in self.KINDS:
-            msg = f"the {self.LANGUAGE} post cannot write {what}"
+            why = f": {self.RUNTIME_REFUSAL}" if self.RUNTIME_REFUSAL else ""
+            msg = f"the {self.LANGUAGE} post cannot write {what}{why}"
             return [_error("runtime_target", msg, step)]
         if not self.manifest.runtime_targets:
             msg = (
