@@ -39,7 +39,6 @@ from olp.frontends.krl.values import (
     CARTESIAN,
     EXTERNAL,
     Unknown,
-    as_int,
     is_axis_aggregate,
 )
 from olp.vendors.kuka import configuration_from_status_turn, frame_to_pose, pose_to_frame
@@ -259,7 +258,6 @@ class Motions(InlineForms):
                 motion=_RUNTIME_KINDS[base],
                 target=self._target_expr(stmt.targets[-1]),
                 via=self._target_expr(stmt.targets[0]) if base == "CIRC" else None,
-                config=self._constant_status_turn(stmt.targets[-1], base == "PTP"),
                 reason=reason,
                 **fields,
             )
@@ -270,20 +268,6 @@ class Motions(InlineForms):
         converted = to_expr(expr, self._input_index)
         assert converted is not None
         return converted
-
-    def _constant_status_turn(self, expr: Expr, ptp: bool) -> ir.Configuration | None:
-        """The configuration a run-time PTP target's aggregate asks for with constant S and T
-        (``{X nX, Y nY, ..., S 6, T 27}``), else None (LIN and CIRC ignore S and T)."""
-        if not ptp or not isinstance(expr, Aggregate):
-            return None
-        values = {m.name.upper(): as_int(self._value(m.value)) for m in expr.members}
-        status, turn = values.get("S"), values.get("T")
-        if status is None or turn is None:
-            return None
-        try:
-            return configuration_from_status_turn(status, turn)
-        except ValueError:
-            return None  # the controller reports it when it runs; olp cannot check the move
 
     def _keep_runtime_motion(self, stmt: MotionStmt, base: str, reason: str) -> None:
         """Keep a _REL motion by run-time offsets as written (:class:`~olp.ir.Verbatim`, with a
