@@ -57,10 +57,11 @@ What is lowered
   nowhere else stays an error naming the data list that would declare it.
 * **BAS with run-time values** (``BAS(#PTP_PARAMS, v)``, or ``PDAT_ACT`` given a parameter) is
   kept as written; the settings it sets are ambiguous until set again, and a motion (a
-  run-time one too) after it in the same straight stretch is an error (the output would not write the settings
-  that BAS changed behind its back). A settings routine without motions builds.
+  run-time one too) after it in the same straight stretch is an error (the output would not
+  write the settings that BAS changed behind its back). A settings routine without motions builds.
 * **Unrolled FOR loops** write ``counter = n`` before a pass whose output reads the counter
-  (a statement kept as written such as ``LIN xPath[i]``, ``r[i] = $OV_PRO``, ``Foo(i)``).
+  (a run-time motion such as ``LIN xPath[i]``, a statement kept as written such as
+  ``r[i] = $OV_PRO``, ``Foo(i)``).
 * **Speeds.** ``$VEL.CP`` (m/s) -> ``Speed.linear``; ``$VEL_AXIS[i]``/``$ACC_AXIS[i]`` (%) ->
   ``Speed.joint``/``joint_acceleration`` as the **minimum** over the axes set so far (one
   fraction cannot hold per-axis values; the slowest axis bounds a synchronised PTP).
