@@ -540,6 +540,11 @@ class RuntimeMove:
     before any other. ``config``: the configuration the source asks for where it says so
     without run-time values (KUKA S and T given as constants), else None. ``reason``: why the
     target is known only at run time, in words, for the notes that say what olp does not check.
+    ``controller_settings``: the motion runs with the tool, base, speed and approximation the
+    controller holds, set by a statement kept as written right before it (a KRL ``BAS`` reading
+    a ``$config.dat`` olp was not given); ``speed``, ``zone``, ``tool`` and ``frame`` then mean
+    nothing, a post writes none of them (only a post of that statement's language can write
+    the motion), and the motion after it writes all of its own.
 
     Passes cannot check it (reach, limits, collisions) or time it, and the motion after it
     starts where olp does not know (:mod:`olp.passes.resolve`); a post writes it back where
@@ -558,6 +563,7 @@ class RuntimeMove:
     frame: Frame = field(default_factory=lambda: WORLD)
     config: Configuration | None = None
     reason: str = ""
+    controller_settings: bool = False
     span: SourceSpan = GENERATED
     kind: Literal["runtime_move"] = field(default="runtime_move", init=False)
 

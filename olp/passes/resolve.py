@@ -190,9 +190,13 @@ def _runtime_step(
     """A motion to a run-time target: its tool and frame looked up (a post writes them before
     it), nothing else checked; a warning says what is not (``runtime_target``), and the next
     motion starts where olp does not know (:func:`_after_unknown_start`)."""
-    tool = ins.tool if ins.tool.pose is not None else station.tool(ins.tool)
-    frame = ins.frame if ins.frame.pose is not None else station.frame(ins.frame)
-    found = _lookup_errors(index, ins, tool, frame)
+    tool: Tool | None = None
+    frame: Frame | None = None
+    found: list[Diagnostic] = []
+    if not ins.controller_settings:  # else its tool and frame are the controller's
+        tool = ins.tool if ins.tool.pose is not None else station.tool(ins.tool)
+        frame = ins.frame if ins.frame.pose is not None else station.frame(ins.frame)
+        found = _lookup_errors(index, ins, tool, frame)
     why = f" ({ins.reason})" if ins.reason else ""
     message = (
         f"{_MOVE_WORDS[ins.motion]} to a target known only when the program runs{why}: olp "

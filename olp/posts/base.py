@@ -522,6 +522,12 @@ class Post:
                 "and declare runtime_targets: true"
             )
             return [_error("runtime_target", msg, step, hint=hint)]
+        if ins.controller_settings and self.VERBATIM is None:
+            msg = (
+                f"the {self.LANGUAGE} post cannot write {what}: it runs with the settings that a "
+                "statement of another language, kept as written, sets before it"
+            )
+            return [_error("runtime_target", msg, step)]
         return self._arc_checks(step, ins) if ins.motion == "circular" else []
 
     def _arc_checks(self, step: Step, ins: Any) -> list[Diagnostic]:

@@ -716,7 +716,10 @@ class FanucPost(Post):
 def _runtime_checks(post: Post, compiled: CompiledProgram) -> list[Diagnostic]:
     """``runtime_target`` (error): a motion to a run-time target whose target LS cannot name
     as a position register (:func:`position_register`)."""
-    runtime = [s for s in compiled.steps if isinstance(s.instruction, ir.RuntimeMove)]
+    items = items_of(compiled.steps)  # a toolpath's rows stay a block: none is a run-time motion
+    runtime = [
+        s for s in items if isinstance(s, Step) and isinstance(s.instruction, ir.RuntimeMove)
+    ]
     if not runtime:
         return []
     from olp.posts.flow import weave

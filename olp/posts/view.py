@@ -132,7 +132,9 @@ class PostStep:
     ``instruction.target`` / ``instruction.via`` are expressions): ``tool``, ``frame``,
     ``tool_name``, ``frame_name``, ``frame_pose`` and the ``new_*`` flags as for any motion (the
     settings it runs with are written before it); ``motion`` is 0, and there is no ``joints``,
-    ``pose`` or ``name``.
+    ``pose`` or ``name``. One that runs with the controller's settings
+    (``instruction.controller_settings``) has no tool, frame or flags: nothing is written before
+    it, and the motion after it writes every setting.
 
     Comments: ``comment`` (added), the text as the post's comment lines (escaped: a line break
     of the text starts another comment line, never a statement).
@@ -524,7 +526,10 @@ class ProgramView:
                     out.append(self._rows(step, names, last))
                 continue
             ins = step.instruction
-            if isinstance(ins, RuntimeMove):
+            if isinstance(ins, RuntimeMove) and ins.controller_settings:
+                out.append(PostStep(step.index, ins.kind, ins.span.location, ins))
+                last.clear()  # it runs with the controller's settings: the next sets its own
+            elif isinstance(ins, RuntimeMove):
                 if _written_runtime(step):
                     out.append(self._runtime_step(step, names, last))
             elif not isinstance(ins, MOTION_TYPES):
@@ -675,7 +680,8 @@ def _written_motion(step: Step) -> bool:
 
 
 def _written_runtime(step: Step) -> bool:
-    """Whether a motion to a run-time target is written: its tool and frame resolved."""
+    """Whether a motion to a run-time target is written with settings: its tool and frame
+    resolved (one that runs with the controller's settings has none)."""
     tool, frame = step.tool, step.frame
     return (
         tool is not None and tool.pose is not None and frame is not None and frame.pose is not None

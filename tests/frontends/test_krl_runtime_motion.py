@@ -17,6 +17,15 @@ REPO = Path(__file__).resolve().parents[2]
 CONFIG = REPO / "examples" / "robot_config.dat"
 HOME = "PTP {A1 0,A2 -90,A3 90,A4 0,A5 30,A6 0}"
 SETUP = ("$BASE = BASE_DATA[1]", "$TOOL = TOOL_DATA[1]", "$VEL.CP = 0.2", "$APO.CDIS = 5", HOME)
+AGAIN = (
+    "$BASE = BASE_DATA[1]",
+    "$TOOL = TOOL_DATA[1]",
+    "BAS (#VEL_PTP, 50)",
+    "BAS (#ACC_PTP, 50)",
+    "$APO.CDIS = 5",
+    HOME,
+)
+"""Every setting a BAS #PTP_PARAMS sets, set again (as the next inline form does)."""
 
 
 @pytest.fixture(scope="module")
@@ -92,9 +101,51 @@ def test_a_rel_motion_by_run_time_offsets_stays_as_written(config: KrlData) -> N
     assert [n.text for n in kept] == ["LIN_REL pOff"] and runtime(result) == []
 
 
-def test_a_run_time_motion_after_a_run_time_bas_is_still_refused(config: KrlData) -> None:
-    """BAS with a run-time value changes the settings behind the output's back: a motion in
-    the same straight stretch after it, run-time or not, is an error naming the BAS."""
+def test_the_motion_right_after_a_run_time_bas_runs_with_the_controller_settings(
+    config: KrlData,
+) -> None:
+    """BAS with a run-time value changes the settings behind the output's back: the motion
+    right after it runs with them (a run-time motion with ``controller_settings``: nothing is
+    written between the BAS and it); a second motion still relying on them is an error."""
     body = ("DECL REAL v", "DECL E6POS xPath[2]", "DECL INT i", *SETUP, "v = $OV_PRO")
+    result = lower(*body, "i = $IN[1]", "BAS(#PTP_PARAMS, v)", "PTP xPath[i]", config=config)
+    (ptp,) = runtime(result)
+    assert ptp.controller_settings and "BAS(#PTP_PARAMS, v)" in ptp.reason
     with pytest.raises(ParseError, match=r"BAS\(#PTP_PARAMS\) at line 12 sets them"):
-        lower(*body, "i = $IN[1]", "BAS(#PTP_PARAMS, v)", "PTP xPath[i]", config=config)
+        lower(*body, "i = $IN[1]", "BAS(#PTP_PARAMS, v)", "PTP xPath[i]", HOME, config=config)
+
+
+PENDANT_HOME = (
+    "PDAT_ACT=PDEFAULT",
+    "FDAT_ACT=FHOME",
+    "BAS (#PTP_PARAMS,100 )",
+    "$H_POS=XHOME",
+    "PTP  XHOME",
+)
+"""The pendant's PTP HOME inline form: BAS reads FHOME and PDEFAULT of ``$config.dat``."""
+
+
+def test_the_pendant_home_without_config_dat_runs_with_the_controller_settings() -> None:
+    """Without ``$config.dat`` the BAS's tool, base and speeds are the cell's: the BAS is kept
+    as written (with the data assignments it reads), and ``PTP XHOME`` right after it is a
+    run-time motion with the controller's settings (the KRL post writes none before it). A
+    motion after it that sets its own settings is lowered as before; one that does not is
+    still an error (its settings are the BAS's, unknown)."""
+    result = lower(*PENDANT_HOME, *AGAIN)
+    (home,) = runtime(result)
+    assert home.controller_settings and home.motion == "joint" and home.span.line == 6
+    assert "$config.dat" in home.reason and "BAS (#PTP_PARAMS,100 )" in home.reason
+    kept = [n for n in result.program if isinstance(n, ir.Verbatim)]
+    assert [n.text for n in kept] == ["BAS (#PTP_PARAMS,100 )"]
+    assigned = [n for n in result.program if isinstance(n, ir.Assign)]
+    assert [n.target for n in assigned] == [
+        ir.Name(name="PDAT_ACT", span=assigned[0].target.span),
+        ir.Name(name="FDAT_ACT", span=assigned[1].target.span),
+    ]
+    with pytest.raises(ParseError, match="cannot tell which motion settings"):
+        lower(*PENDANT_HOME, HOME)
+
+
+def test_with_config_dat_the_pendant_home_is_modelled() -> None:
+    result = lower(*PENDANT_HOME, *AGAIN, config=load_config_dat(CONFIG))
+    assert runtime(result) == [] and len(list(result.program.motions())) == 2

@@ -157,3 +157,30 @@ def test_olp_build_exit_codes(tmp_path: Path) -> None:
     refused = ["build", str(CELL), str(program), "--post", "ur", "-o", str(tmp_path / "ur")]
     assert main([*refused, "--no-collisions", "-q"]) == 1
     assert not (tmp_path / "ur").exists()
+
+
+def test_the_pendant_home_without_config_dat_is_written_without_settings(
+    station: olp.Station, tmp_path: Path
+) -> None:
+    """``PTP XHOME`` after the kept BAS runs with what that BAS sets: the KRL post writes the
+    motion right after it, no setting in between, and every setting before the next motion;
+    a post of another language refuses it (and the BAS)."""
+    lines = (
+        "DEF path( )",
+        "PDAT_ACT=PDEFAULT",
+        "FDAT_ACT=FHOME",
+        "BAS (#PTP_PARAMS,100 )",
+        "PTP  XHOME",
+        *SETUP,
+        "BAS (#VEL_PTP, 50)",
+        "BAS (#ACC_PTP, 50)",
+        HOME,
+        "END",
+    )
+    result = build(station, tmp_path, lines)
+    assert result.ok, errors(result)
+    src = result.files["path.src"].splitlines()
+    bas = src.index("BAS (#PTP_PARAMS,100 )")
+    assert src[bas + 1] == "PTP XHOME" and src[bas + 2].startswith("$BASE = ")
+    abb = build(station, tmp_path, lines, post="abb")
+    assert any(e[0] == "runtime_target" and e[1] == 5 for e in errors(abb))

@@ -269,6 +269,55 @@ class Motions(InlineForms):
         assert converted is not None
         return converted
 
+    def _controller_settings_motion(self, stmt: MotionStmt) -> bool:
+        """The motion right after a BAS kept as written (its values known only at run time, a
+        ``$config.dat`` olp was not given among them: the pendant's ``FDAT_ACT=FHOME``,
+        ``BAS(#PTP_PARAMS,100)``, ``PTP XHOME``), in the same straight stretch, when that BAS
+        is all that leaves its settings unknown: a :class:`~olp.ir.RuntimeMove` that runs with
+        the controller's settings (``controller_settings``: the KRL post writes no setting
+        before it, so the BAS's hold), its target an expression. Not for a _REL or WITH
+        motion. Returns whether it lowered ``stmt`` (else the caller's error stands)."""
+        bas = self._kept_bas_before()
+        base = _BASE_MOTION.get(stmt.keyword)
+        ambiguous: dict[str, str] = getattr(self, "ambiguous", {})
+        from_bas = all(why.startswith("BAS(#") for why in ambiguous.values())
+        expected = 2 if base == "CIRC" else 1
+        if bas is None or base is None or not from_bas or len(stmt.targets) != expected:
+            return False
+        if stmt.keyword.endswith("_REL") or stmt.with_clause or stmt.angle is not None:
+            return False
+        self.motion_count += 1
+        runtime = self._runtime_target(stmt)
+        why = f"its settings are what {bas.text} (line {bas.span.line}) sets at run time"
+        if stmt.approx:
+            self._note(
+                stmt.span,
+                f"{' '.join(stmt.approx)} after {bas.text}: the approximation distance is the "
+                "controller's, unknown to olp; written as an exact stop",
+            )
+        self.out.append(
+            ir.RuntimeMove(
+                motion=_RUNTIME_KINDS[base],
+                target=self._target_expr(stmt.targets[-1]),
+                via=self._target_expr(stmt.targets[0]) if base == "CIRC" else None,
+                reason=why if runtime is None else f"{runtime}; {why}",
+                controller_settings=True,
+                span=stmt.span,
+            )
+        )
+        self.track.lose(f"the {stmt.keyword} at line {stmt.span.line} runs with unknown settings")
+        return True
+
+    def _kept_bas_before(self) -> ir.Verbatim | None:
+        """The BAS kept as written (one given run-time values) that the next motion follows
+        in the same straight stretch, or None."""
+        for node in reversed(self.out):
+            if isinstance(node, (ir.Label, ir.RuntimeMove, *ir.BLOCK_TYPES)):
+                return None
+            if isinstance(node, ir.Verbatim) and node.reason.startswith("BAS #"):
+                return node
+        return None
+
     def _keep_runtime_motion(self, stmt: MotionStmt, base: str, reason: str) -> None:
         """Keep a _REL motion by run-time offsets as written (:class:`~olp.ir.Verbatim`, with a
         warning: :class:`~olp.ir.RuntimeMove` holds an absolute target): the KRL post writes it
@@ -292,6 +341,8 @@ class Motions(InlineForms):
         for node in reversed(self.out):
             if isinstance(node, (ir.Label, *ir.BLOCK_TYPES)):
                 return
+            if isinstance(node, ir.RuntimeMove) and node.controller_settings:
+                return  # the output writes every setting of the motion after one again
             if isinstance(node, ir.Verbatim) and node.reason.startswith("BAS #"):
                 raise self._error(
                     f"this motion follows {node.text} (line {node.span.line}), kept as written "
