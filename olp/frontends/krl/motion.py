@@ -273,16 +273,23 @@ class Motions(InlineForms):
         """The motion right after a BAS kept as written (its values known only at run time, a
         ``$config.dat`` olp was not given among them: the pendant's ``FDAT_ACT=FHOME``,
         ``BAS(#PTP_PARAMS,100)``, ``PTP XHOME``), in the same straight stretch, when that BAS
-        is all that leaves its settings unknown: a :class:`~olp.ir.RuntimeMove` that runs with
-        the controller's settings (``controller_settings``: the KRL post writes no setting
-        before it, so the BAS's hold), its target an expression. Not for a _REL or WITH
+        is all that leaves its settings unknown and no setting was assigned since it: a
+        :class:`~olp.ir.RuntimeMove` that runs with the controller's settings
+        (``controller_settings``: the KRL post writes no setting before it, so the BAS's
+        hold), its target an expression. Not for a _REL or WITH
         motion. Returns whether it lowered ``stmt`` (else the caller's error stands)."""
         bas = self._kept_bas_before()
         base = _BASE_MOTION.get(stmt.keyword)
         ambiguous: dict[str, str] = getattr(self, "ambiguous", {})
         from_bas = all(why.startswith("BAS(#") for why in ambiguous.values())
+        # nothing set since the BAS: a setting the program set in between is one the output
+        # would write only before a motion with settings, so this one would run without it
+        untouched = self.kept_bas is not None and self.kept_bas[0] is bas
+        untouched = untouched and self.kept_bas is not None and self.kept_bas[1] == self.state
         expected = 2 if base == "CIRC" else 1
-        if bas is None or base is None or not from_bas or len(stmt.targets) != expected:
+        if bas is None or base is None or not (from_bas and untouched):
+            return False
+        if len(stmt.targets) != expected:
             return False
         if stmt.keyword.endswith("_REL") or stmt.with_clause or stmt.angle is not None:
             return False

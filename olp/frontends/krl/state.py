@@ -374,6 +374,8 @@ class Core:
         self._reported: set[tuple[Any, ...]] = set()
         self.motion_count = 0  # motions lowered so far (by this lowering)
         self.here_vars: dict[str, tuple[str, int]] = {}  # name -> ($POS_ACT..., motion_count)
+        # the last BAS kept as written (run-time values) and the motion settings when it ran
+        self.kept_bas: tuple[ir.Verbatim, State] | None = None
         self._setters: dict[str, Callable[[str, Expr, Stmt], None]] = {
             "$VEL.CP": self._set_vel_cp,
             "$ACC.CP": self._set_acc_cp,
