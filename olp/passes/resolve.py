@@ -14,6 +14,11 @@
   starts, ends or passes at a singular pose (wrist, shoulder, elbow) without a jump gets a
   warning (:func:`_singular_warnings`).
 
+* A motion to a run-time target (:class:`~olp.ir.RuntimeMove`) is not checked: a warning
+  (``runtime_target``) says why; the motion after it starts where olp does not know, so only
+  its target is checked (reach, configuration, joint limits, in the solution nearest the last
+  known joints) and its path is not: a warning (``unknown_start``), end joints but no path.
+
 The result is a :class:`olp.compiled.CompiledProgram`: the program, one step per instruction
 (end joints, resolved tool and frame, sampled joint path of a motion) and the diagnostics.
 """

@@ -27,6 +27,15 @@ the confidence given:
   circular angle (the base post's ``arc_orientation`` / ``arc_angle`` errors).
   ``ConfJ \\On`` / ``ConfL \\On`` make the controller take the written confdata. Joint moves are
   limited by the speeddata's TCP speed: RAPID has no joint speed fraction (warned).
+* Motions to run-time targets (:class:`~olp.ir.RuntimeMove`): ``MoveL`` / ``MoveJ`` /
+  ``MoveC via, to`` to a ``robtarget`` variable (or an element of an array of them, ``xPath{i}``)
+  the program declares, ``MoveAbsJ ...\\NoEOffs`` to a ``jointtarget`` one, with the same
+  speed, zone, tool and ``\\WObj`` arguments as any move (RAPID reference, MoveL: ``MoveL
+  ToPoint, Speed, Zone, Tool [\\WObj]``, ToPoint a robtarget "defined as a named position";
+  as recalled, medium confidence; that an array element may stand there is unverified against
+  a stored manual: ``rapidchecker`` accepts ``MoveL xPath{i}, ...`` but no index with an
+  operator, ``xPath{i + 1}``). Anything else is an error on the motion
+  (:mod:`olp.posts.runtime`).
 * ``Speed.linear_acceleration`` (m/s²) as ``PathAccLim TRUE \\AccMax:=a, TRUE \\DecelMax:=a;``
   before the path move where it changes, and ``PathAccLim FALSE, FALSE;`` where it is unset
   again or before a joint move (olp's estimate limits only path moves with it). PathAccLim
