@@ -520,6 +520,68 @@ class CircularMove(_Motion):
             raise IRError(f"CircularMove.orientation must be an ArcOrientation, got {found!r}")
 
 
+RUNTIME_MOTIONS = ("joint", "linear", "circular")
+"""The motion kinds of a :class:`RuntimeMove`."""
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class RuntimeMove:
+    """A motion whose target is an expression olp cannot evaluate offline: a variable set at
+    run time (``LIN xPath[i]`` with ``i`` a parameter), a function's result (``PTP
+    fnGetPos()``), a controller variable (``$POS_ACT``), or a name whose value lives in a file
+    olp was not given (``PTP XHOME`` without the controller's ``$config.dat``).
+
+    ``motion``: ``"joint"``, ``"linear"`` or ``"circular"`` (:data:`RUNTIME_MOTIONS`);
+    ``target``: the end point as an expression (:mod:`olp.ir_flow`: a :class:`Name`, an
+    :class:`Index`, a :class:`FunctionCall`, an :class:`Aggregate` with run-time members ...);
+    ``via``: a circular move's auxiliary point (an expression), None otherwise; ``angle`` and
+    ``orientation``: a circular move's, as :class:`CircularMove` has them. ``speed``, ``zone``,
+    ``tool`` and ``frame``: the settings in effect, which a post writes before the motion like
+    before any other. ``config``: the configuration the source asks for where it says so
+    without run-time values (KUKA S and T given as constants), else None. ``reason``: why the
+    target is known only at run time, in words, for the notes that say what olp does not check.
+    ``controller_settings``: the motion runs with the tool, base, speed and approximation the
+    controller holds, set by a statement kept as written right before it (a KRL ``BAS`` reading
+    a ``$config.dat`` olp was not given); ``speed``, ``zone``, ``tool`` and ``frame`` then mean
+    nothing, a post writes none of them (only a post of that statement's language can write
+    the motion), and the motion after it writes all of its own.
+
+    Passes cannot check it (reach, limits, collisions) or time it, and the motion after it
+    starts where olp does not know (:mod:`olp.passes.resolve`); a post writes it back where
+    its language can name the target (:mod:`olp.posts`), else stops with an error on its line.
+    Not a :data:`MOTION_TYPES` motion: code that walks motions with targets never meets one.
+    """
+
+    motion: Literal["joint", "linear", "circular"]
+    target: _flow.Expr
+    via: _flow.Expr | None = None
+    angle: float | None = None
+    orientation: ArcOrientation = ArcOrientation.INTERPOLATE
+    speed: Speed = field(default_factory=Speed)
+    zone: Zone = FINE
+    tool: Tool = field(default_factory=lambda: FLANGE)
+    frame: Frame = field(default_factory=lambda: WORLD)
+    config: Configuration | None = None
+    reason: str = ""
+    controller_settings: bool = False
+    span: SourceSpan = GENERATED
+    kind: Literal["runtime_move"] = field(default="runtime_move", init=False)
+
+    def __post_init__(self) -> None:
+        if self.motion not in RUNTIME_MOTIONS:
+            raise IRError(
+                f"RuntimeMove.motion must be one of {RUNTIME_MOTIONS}, got {self.motion!r}"
+            )
+        if (self.via is not None) != (self.motion == "circular"):
+            raise IRError("RuntimeMove.via is given for a circular move, and only for one")
+        if self.angle is not None and (
+            self.motion != "circular" or not (np.isfinite(self.angle) and self.angle != 0.0)
+        ):
+            raise IRError(
+                f"RuntimeMove.angle: a circular move's, finite and not 0, got {self.angle}"
+            )
+
+
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Wait:
     """Dwell for ``seconds``."""
@@ -577,6 +639,7 @@ Instruction: TypeAlias = (
     JointMove
     | LinearMove
     | CircularMove
+    | RuntimeMove
     | Wait
     | SetOutput
     | WaitInput

@@ -8,7 +8,9 @@ TCP travel) and ``start_s`` per instruction (its start time in the cycle), and f
 with control flow ``paths`` (:func:`paths_dict`: the shortest and longest path's time and the
 branch choices that give each, what was assumed, how loops were counted); there
 ``cycle_time_s`` is the longest path's time (the named path's, when ``--assume`` decides every
-branch), while ``start_s`` and ``time_s`` follow the text, each instruction once.
+branch), while ``start_s`` and ``time_s`` follow the text, each instruction once; and
+``untimed_motions``: how many motions the cycle time leaves out (to or from a target known only
+at run time: ``cycle_time_s`` is then a lower bound).
 
 The timing tables of ``olp time`` (:func:`timing_summary`, :func:`timing_table`,
 :func:`sweep_table`) live here too.
@@ -27,7 +29,7 @@ import numpy as np
 
 from olp.api import BuildResult
 from olp.errors import excerpt, line_of
-from olp.ir import is_motion
+from olp.ir import RuntimeMove, is_motion
 from olp.passes.wording import quantity
 
 if TYPE_CHECKING:
@@ -74,6 +76,7 @@ def report_dict(result: BuildResult) -> dict[str, Any]:
         "files": [str(p) for p in result.written],
         "cycle_time_s": round(_cycle_time(compiled), 6) if compiled.ok else None,
         "path_length_m": round(_path_length(compiled), 9) if compiled.ok else None,
+        "untimed_motions": untimed_motions(compiled),
         "instructions": instructions,
         "diagnostics": [d.to_json() for d in result.diagnostics],
     }
@@ -125,10 +128,12 @@ def summary(result: BuildResult) -> str:
     resolved = [s for s in motions if s.joints is not None]
     errors = [d for d in result.diagnostics if d.severity == "error"]
     warnings = [d for d in result.diagnostics if d.severity == "warning"]
+    runtime = sum(1 for s in steps if isinstance(s.instruction, RuntimeMove))
+    unchecked = f", {runtime} more to run-time targets, not checked" if runtime else ""
     rows = [
         ("program", f"{compiled.program.name} ({compiled.program.source})"),
         ("station", f"{compiled.station.name} ({compiled.station.robot.name})"),
-        ("instructions", f"{len(steps)} ({len(motions)} motions)"),
+        ("instructions", f"{len(steps)} ({len(motions)} motions{unchecked})"),
         ("reachability", _verdict(len(motions), len(resolved), errors)),
         ("cycle time", _cycle_line(compiled, 2) if compiled.ok else "-"),
         *(_path_rows(compiled.paths) if compiled.ok and compiled.paths else []),
@@ -209,11 +214,34 @@ def _path_length(compiled: CompiledProgram) -> float:
     return float(sum(step.path_length for step in compiled.steps))
 
 
+UNTIMED_KINDS = frozenset({"runtime_target", "unknown_start"})
+"""Diagnostic kinds of the motions the timing pass cannot time (:mod:`olp.passes.resolve`: a
+motion to a run-time target and the motion after it): a cycle time without them is a lower
+bound."""
+
+
+def untimed_motions(compiled: CompiledProgram) -> int:
+    """How many motions the cycle time leaves out (:data:`UNTIMED_KINDS`)."""
+    return sum(1 for d in compiled.diagnostics if d.kind in UNTIMED_KINDS)
+
+
 def _timing_note(compiled: CompiledProgram, pointer: bool = True) -> str:
-    """How to read the cycle time: an estimate, an upper bound where zones became stops."""
+    """How to read the cycle time: an estimate, an upper bound where zones became stops, a
+    lower bound where motions to or from run-time targets are left out (neither with both)."""
     stops = sum(1 for d in compiled.diagnostics if d.kind == "zone_stop")
+    untimed = untimed_motions(compiled)
+    left_out = (
+        f"{untimed} motion{'s' * (untimed > 1)} to or from run-time targets not timed"
+        if untimed
+        else ""
+    )
+    zones = f"{stops} zone{'s' * (stops > 1)} timed as exact stops" if stops else ""
+    if untimed and stops:
+        return f"incomplete, neither an upper nor a lower bound: {left_out}, {zones}"
+    if untimed:
+        return f"lower bound: {left_out}"
     if stops:
-        return f"estimate; upper bound: {stops} zone{'s' * (stops > 1)} timed as exact stops"
+        return f"estimate; upper bound: {zones}"
     return "estimate; olp time says what it includes" if pointer else "estimate"
 
 
@@ -296,6 +324,13 @@ def estimate_scope(compiled: CompiledProgram) -> tuple[str, str]:
             "; with control flow, a blend from one block into the next (across an IF, a loop's "
             "head or end) counts as an exact stop, and the path length and the per-instruction "
             "times follow the text, each instruction once"
+        )
+    untimed = untimed_motions(compiled)
+    if untimed:
+        excludes += (
+            f"; {untimed} motion{'s' * (untimed > 1)} to a target known only at run time or "
+            "from one (where the robot goes or comes from is unknown offline), so the total is "
+            "a lower bound there"
         )
     stops = sum(1 for d in compiled.diagnostics if d.kind == "zone_stop")
     if stops:

@@ -151,3 +151,21 @@ def test_map_deletes_and_expands() -> None:
         lambda i: None if i.kind == "comment" else [i, i] if i.kind == "wait" else i
     )
     assert [i.kind for i in edited] == ["linear", "wait", "wait", "call", "linear"]
+
+
+def test_a_runtime_move_holds_an_expression_and_checks_its_shape() -> None:
+    """A motion to a run-time target: the target an expression, a via point for an arc only,
+    an angle for an arc only; not one of the motions with targets (``is_motion``)."""
+    path = ir.Index(base=ir.Name(name="xPath"), indices=(ir.Name(name="i"),))
+    move = ir.RuntimeMove(motion="linear", target=path, reason="i is set at run time")
+    assert move.kind == "runtime_move" and move.zone.is_fine and not ir.is_motion(move)
+    arc = ir.RuntimeMove(motion="circular", target=path, via=ir.Name(name="pVia"), angle=1.0)
+    assert arc.via == ir.Name(name="pVia")
+    with pytest.raises(ir.IRError, match="via"):
+        ir.RuntimeMove(motion="linear", target=path, via=ir.Name(name="pVia"))
+    with pytest.raises(ir.IRError, match="via"):
+        ir.RuntimeMove(motion="circular", target=path)
+    with pytest.raises(ir.IRError, match="angle"):
+        ir.RuntimeMove(motion="joint", target=path, angle=1.0)
+    with pytest.raises(ir.IRError, match="motion"):
+        ir.RuntimeMove(motion="spline", target=path)  # type: ignore[arg-type]

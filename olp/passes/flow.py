@@ -102,7 +102,7 @@ class _Walk:
             return frozenset({first + len(node) - 1}) if state else state
         index = self.cursor
         self.cursor += 1
-        if ir.is_motion(node):
+        if _moves(node):
             self._record(index, state)
             return frozenset({index}) if state else state  # no path reaches it
         if isinstance(node, ir.Goto):
@@ -151,10 +151,16 @@ def motion_predecessors(program: ir.Program) -> dict[int, frozenset[int]]:
 def _textual_previous(program: ir.Program) -> dict[int, int]:
     previous, out = START, {}
     for index, instruction in enumerate(program):
-        if ir.is_motion(instruction):
+        if _moves(instruction):
             out[index] = previous
             previous = index
     return out
+
+
+def _moves(node: Any) -> bool:
+    """Whether ``node`` moves the robot: a motion, or one to a run-time target (a start of
+    the next motion that olp cannot know, :func:`_check_from`)."""
+    return ir.is_motion(node) or isinstance(node, ir.RuntimeMove)
 
 
 def flow_pass(compiled: CompiledProgram, options: Any) -> CompiledProgram:
@@ -195,7 +201,9 @@ def _check_from(
         joints = compiled.steps[start].joints
         where = f"the motion at line {compiled.steps[start].instruction.span.line}"
     if joints is None:
-        return []  # the start did not resolve: its own error says so
+        # the start did not resolve (its own error says so), or it is a run-time target,
+        # whose motion and the one after it carry their warnings
+        return []
     lead_in = ir.JointMove(target=ir.JointTarget(joints=joints), span=move.span)
     mini = ir.Program(name="path", instructions=(lead_in, move), source=compiled.program.source)
     checked = resolve(mini, compiled.station, getattr(options, "resolve", None))

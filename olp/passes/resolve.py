@@ -14,6 +14,11 @@
   starts, ends or passes at a singular pose (wrist, shoulder, elbow) without a jump gets a
   warning (:func:`_singular_warnings`).
 
+* A motion to a run-time target (:class:`~olp.ir.RuntimeMove`) is not checked: a warning
+  (``runtime_target``) says why; the motion after it starts where olp does not know, so only
+  its target is checked (reach, configuration, joint limits, in the solution nearest the last
+  known joints) and its path is not: a warning (``unknown_start``), end joints but no path.
+
 The result is a :class:`olp.compiled.CompiledProgram`: the program, one step per instruction
 (end joints, resolved tool and frame, sampled joint path of a motion) and the diagnostics.
 """
@@ -46,6 +51,7 @@ from olp.ir import (
     LinearPath,
     Node,
     Program,
+    RuntimeMove,
     SourceSpan,
     Tool,
 )
@@ -118,6 +124,33 @@ def resolve(
     index = flat = 0
     while index < len(nodes):
         node = nodes[index]
+        if isinstance(node, RuntimeMove):
+            step, found = _runtime_step(flat, node, station, state)
+            items.append(step)
+            diags.extend(found)
+            index, flat = index + 1, flat + 1
+            progress.advance(1)
+            continue
+        if state.unknown_start is not None and isinstance(node, LinearPath):
+            step, found = _after_unknown_start(flat, node.move(0), station, state)
+            items.append(step)
+            diags.extend(found)
+            if len(node) > 1:
+                found_items, found = _resolve_path(
+                    flat + 1, node.rows(1, len(node)), station, state
+                )
+                items.extend(found_items)
+                diags.extend(found)
+            index, flat = index + 1, flat + len(node)
+            progress.advance(len(node))
+            continue
+        if state.unknown_start is not None and isinstance(node, MOTION_TYPES):
+            step, found = _after_unknown_start(flat, node, station, state)
+            items.append(step)
+            diags.extend(found)
+            index, flat = index + 1, flat + 1
+            progress.advance(1)
+            continue
         if isinstance(node, LinearPath):
             found_items, found = _resolve_path(flat, node, station, state)
             items.extend(found_items)
@@ -153,15 +186,107 @@ def resolve(
     )
 
 
+_MOVE_WORDS = {"joint": "joint move", "linear": "linear move", "circular": "circular move"}
+
+
+def _runtime_step(
+    index: int, ins: RuntimeMove, station: Station, state: _State
+) -> tuple[Step, list[Diagnostic]]:
+    """A motion to a run-time target: its tool and frame looked up (a post writes them before
+    it), nothing else checked; a warning says what is not (``runtime_target``), and the next
+    motion starts where olp does not know (:func:`_after_unknown_start`)."""
+    tool: Tool | None = None
+    frame: Frame | None = None
+    found: list[Diagnostic] = []
+    if not ins.controller_settings:  # else its tool and frame are the controller's
+        tool = ins.tool if ins.tool.pose is not None else station.tool(ins.tool)
+        frame = ins.frame if ins.frame.pose is not None else station.frame(ins.frame)
+        found = _lookup_errors(index, ins, tool, frame)
+    why = f" ({ins.reason})" if ins.reason else ""
+    message = (
+        f"{_MOVE_WORDS[ins.motion]} to a target known only when the program runs{why}: olp "
+        "cannot check it (reach, joint limits, singularities, collisions) or time it; the "
+        "cycle time leaves it out"
+    )
+    found.append(Diagnostic("warning", "runtime_target", message, ins.span, index))
+    state.unknown_start = ins
+    return Step(index=index, instruction=ins, tool=tool, frame=frame), found
+
+
+def _after_unknown_start(
+    index: int, ins: JointMove | LinearMove | CircularMove, station: Station, state: _State
+) -> tuple[Step, list[Diagnostic]]:
+    """The first motion after a run-time motion: it starts where olp does not know, so its
+    path cannot be checked (a line, an arc, the joint-space path) nor timed; its target still
+    is: reachable, in the configuration the target asks for, within the joint limits (a
+    joint move to it from the last known joints, whose path is then dropped). The joints
+    taken are the solution nearest to the last known ones: the next motions are checked from
+    there. A warning (``unknown_start``) says so; the step has end joints but no path (the
+    timing pass gives it no time)."""
+    runtime, state.unknown_start = state.unknown_start, None
+    assert runtime is not None
+    tool = ins.tool if ins.tool.pose is not None else station.tool(ins.tool)
+    frame = ins.frame if ins.frame.pose is not None else station.frame(ins.frame)
+    found = _lookup_errors(index, ins, tool, frame)
+    if tool is None or frame is None:
+        return Step(index=index, instruction=ins, tool=tool, frame=frame), found
+    joint = (
+        ins
+        if isinstance(ins, JointMove)
+        else JointMove(target=ins.target, tool=ins.tool, frame=ins.frame, span=ins.span)
+    )
+    path, checked = _joint_path(index, joint, tool, frame, state)
+    found += checked
+    if path is None:
+        _restart_at_target(ins, tool, frame, state)
+        return Step(index=index, instruction=ins, tool=tool, frame=frame), found
+    state.q = path[-1].copy()
+    kind = _MOVE_WORDS[ins.kind]
+    message = (
+        f"this {kind} starts where the motion to a run-time target at line "
+        f"{runtime.span.line} ends, which olp cannot know: only its target is checked (reach, "
+        "joint limits, in the solution nearest the last known joints); its path (singularities, "
+        "collisions) and its time are not, and the cycle time leaves it out"
+    )
+    found.append(Diagnostic("warning", "unknown_start", message, ins.span, index))
+    step = Step(index=index, instruction=ins, joints=path[-1], tool=tool, frame=frame)
+    return step, found
+
+
+def _lookup_errors(
+    index: int,
+    ins: JointMove | LinearMove | CircularMove | RuntimeMove,
+    tool: Tool | None,
+    frame: Frame | None,
+) -> list[Diagnostic]:
+    """Errors for a motion's tool or frame that the station does not define."""
+    out = []
+    if tool is None:
+        name = ins.tool.name
+        msg = f"tool {name!r} is not defined in the station"
+        out.append(_error("unknown_tool", msg, index, ins))
+    if frame is None:
+        name = ins.frame.name
+        out.append(
+            _error("unknown_frame", f"frame {name!r} is not defined in the station", index, ins)
+        )
+    return out
+
+
 def _node_of(item: Item) -> Node:
     return item.node if isinstance(item, PathBlock) else item.instruction
 
 
 @dataclass(slots=True)
 class _State:
+    """Where resolving stands: ``q`` (dof,) rad, the joints after the last motion resolved;
+    ``unknown_start``: the run-time motion (:class:`~olp.ir.RuntimeMove`) the robot went to
+    since, whose end olp cannot know (the next motion's start), else None."""
+
     q: FloatArray
     robot: Robot
     opts: ResolveOptions
+    unknown_start: RuntimeMove | None = None
 
 
 def _error(kind: str, message: str, index: int, ins: Instruction, **kw: object) -> Diagnostic:

@@ -27,6 +27,15 @@ the confidence given:
   circular angle (the base post's ``arc_orientation`` / ``arc_angle`` errors).
   ``ConfJ \\On`` / ``ConfL \\On`` make the controller take the written confdata. Joint moves are
   limited by the speeddata's TCP speed: RAPID has no joint speed fraction (warned).
+* Motions to run-time targets (:class:`~olp.ir.RuntimeMove`): ``MoveL`` / ``MoveJ`` /
+  ``MoveC via, to`` to a ``robtarget`` variable (or an element of an array of them, ``xPath{i}``)
+  the program declares, ``MoveAbsJ ...\\NoEOffs`` to a ``jointtarget`` one, with the same
+  speed, zone, tool and ``\\WObj`` arguments as any move (RAPID reference, MoveL: ``MoveL
+  ToPoint, Speed, Zone, Tool [\\WObj]``, ToPoint a robtarget "defined as a named position";
+  as recalled, medium confidence; that an array element may stand there is unverified against
+  a stored manual: ``rapidchecker`` accepts ``MoveL xPath{i}, ...`` but no index with an
+  operator, ``xPath{i + 1}``). Anything else is an error on the motion
+  (:mod:`olp.posts.runtime`).
 * ``Speed.linear_acceleration`` (m/s²) as ``PathAccLim TRUE \\AccMax:=a, TRUE \\DecelMax:=a;``
   before the path move where it changes, and ``PathAccLim FALSE, FALSE;`` where it is unset
   again or before a joint move (olp's estimate limits only path moves with it). PathAccLim
@@ -71,6 +80,7 @@ from olp.ir_flow import leaves_and_blocks
 from olp.posts.base import Filter, Post
 from olp.posts.flow_text import (
     FLOW_STEP_KINDS,
+    FlowProblem,
     Symbols,
     flow_lines_filter,
     flow_pad_filter,
@@ -82,6 +92,7 @@ from olp.posts.flow_text import (
 from olp.posts.numbers import NumberFormat, Storage
 from olp.posts.rapid_flow import RapidWriter, counter_problems, reference_problems
 from olp.posts.rows import number_column
+from olp.posts.runtime import pose_kind, program_nodes, targets
 from olp.posts.sandbox import SafeText
 from olp.posts.text import IDENTIFIER, NUMBER, ArgumentRule, NameRule, one_of
 from olp.posts.view import RowColumns
@@ -470,8 +481,28 @@ def _confdata_filter(post: Post, joints: ArrayLike, robot: Any) -> str:
     return rapid_confdata(confdata(robot, joints))
 
 
+def rapid_runtime(post: Post, step: PostStep) -> dict[str, Any]:
+    """Template filter ``s | rapid_runtime``: a motion to a run-time target as RAPID names it,
+    ``{"target": ..., "via": ..., "joints": bool}``: each a pose variable the program declares
+    (:func:`olp.posts.runtime.pose_kind`) spelled by the file's flow writer; ``joints``: the
+    target is a ``jointtarget`` (written with ``MoveAbsJ``). What cannot be written is an error
+    on the motion (:meth:`AbbPost.check_instruction` reports it before rendering)."""
+    writer = getattr(post, "flow", None)
+    assert isinstance(writer, RapidWriter)
+    ins: Any = step.instruction
+    post.current_step = step
+    try:
+        kind = pose_kind(ins.target, writer.symbols, "RAPID")
+        via = "" if ins.via is None else writer.expr(ins.via)
+        return {"target": writer.expr(ins.target), "via": via, "joints": kind == "joints"}
+    except FlowProblem as exc:
+        post.problems.append(Diagnostic("error", "runtime_target", str(exc), ins.span, step.index))
+        return {"target": "?", "via": "?", "joints": False}
+
+
 FILTERS: Mapping[str, Filter] = {
     **Post.FILTERS,
+    "rapid_runtime": rapid_runtime,
     "rapid_flow": flow_lines_filter,
     "rapid_routine_head": lambda post, routine: post.flow.routine_head(routine),
     "rapid_routine_end": lambda post, routine: post.flow.routine_end(routine),
@@ -514,6 +545,7 @@ class AbbPost(Post):
     PREDEFINED_NAMES = PREDEFINED_NAMES
     WRITES_FLOW = True
     WRITES_ROUTINES = True
+    KINDS: ClassVar[frozenset[str]] = Post.KINDS | {"runtime_move"}
 
     def __init__(self, manifest: Any) -> None:
         super().__init__(manifest)
@@ -550,7 +582,7 @@ class AbbPost(Post):
         for step in steps:
             if isinstance(step, RowColumns):
                 self._row_data(step, speeds, zones)
-            elif step.motion:
+            elif step.motion or step.kind == "runtime_move":
                 self._motion_data(step, speeds, zones)
         self.current_step = None
         flow = self.flow = self.writer([s.instruction for s in steps if s.kind in FLOW_STEP_KINDS])
@@ -602,6 +634,8 @@ class AbbPost(Post):
         * ``io_name`` (error): an I/O number whose signal name (the options ``output_signal``
           / ``input_signal``) is not a legal RAPID name."""
         ins: Any = step.instruction
+        if ins.kind == "runtime_move":
+            return self._runtime_target_checks(step, compiled)
         if ins.kind == "joint" and not step.skipped and ins.speed.joint < 1.0:
             return [_joint_speed_warning(self, step.index, ins)]
         if ins.kind in ("set_output", "wait_input"):
@@ -612,6 +646,31 @@ class AbbPost(Post):
                 msg = f"signal name {name!r} (option {option} {pattern!r}): not a legal RAPID name"
                 return [Diagnostic("error", "io_name", msg, ins.span, step.index)]
         return []
+
+    def _runtime_target_checks(self, step: Step, compiled: CompiledProgram) -> list[Diagnostic]:
+        """``runtime_target`` (error): a motion to a run-time target whose target (or via point)
+        is not a ``robtarget`` or ``jointtarget`` variable the program declares, or a linear or
+        circular move to a ``jointtarget`` (``MoveL``/``MoveC`` take robtargets; RAPID
+        reference, MoveL: ``MoveL ToPoint, Speed, Zone, Tool [\\WObj]``, ToPoint of type
+        robtarget). A joint move gets the ``joint_speed`` warning as any."""
+        ins: Any = step.instruction
+        nodes = program_nodes(compiled.program)
+        writer = self.writer(nodes)
+        found = []
+        try:
+            kinds = [pose_kind(expr, writer.symbols, "RAPID") for expr in targets(ins)]
+            for expr in targets(ins):
+                writer.expr(expr)
+            if ins.motion != "joint" and "joints" in kinds:
+                raise FlowProblem(
+                    f"a {ins.motion} move takes a robtarget, and its target is a jointtarget"
+                )
+        except FlowProblem as exc:
+            msg = f"the run-time target cannot be written in RAPID: {exc}"
+            found.append(Diagnostic("error", "runtime_target", msg, ins.span, step.index))
+        if ins.motion == "joint" and ins.speed.joint < 1.0:
+            found.append(_joint_speed_warning(self, step.index, ins))
+        return found
 
     def check_program(self, compiled: CompiledProgram) -> list[Diagnostic]:
         """``tool_load`` (warning, once per tool): the tooldata's load is a placeholder (no

@@ -28,6 +28,9 @@ What every post checks (:meth:`Post.check`), so that no brand can forget it:
   ``call_argument``);
 * digital I/O numbers within the controller's range (``IO_RANGE``, ``io_range``);
 * a station robot of another brand than the post's (a warning, ``foreign_robot``);
+* a motion to a run-time target (:class:`~olp.ir.RuntimeMove`) is written only by a post whose
+  ``KINDS`` hold ``runtime_move``, from a template folder that declares ``runtime_targets:
+  true``; else an error on its line (``runtime_target``);
 * a :class:`~olp.ir.Verbatim` statement of another language than the post's ``VERBATIM`` is an
   error naming its line (``verbatim``); with the post option ``foreign_verbatim: drop`` (in a
   template folder, or ``olp build --drop-foreign-verbatim``) it is left out with a warning
@@ -166,6 +169,9 @@ class Post:
     """The orientation rules of circular moves this language can write (the three-point arc
     interpolating start to end, unless a brand says otherwise); any other is an error on the
     move's line, never a different path."""
+    RUNTIME_REFUSAL: ClassVar[str] = ""
+    """Why the post cannot write motions to run-time targets (``runtime_move`` not in
+    :attr:`KINDS`), for the error on such a motion."""
     ARC_ANGLE: ClassVar[bool] = False
     """Whether a circular move's circular angle (KUKA's CA) can be written."""
     ACCELERATIONS: ClassVar[frozenset[str]] = frozenset()
@@ -479,6 +485,8 @@ class Post:
         kind = ins.kind
         if kind == "verbatim":
             return self._verbatim_checks(step, ins)
+        if kind == "runtime_move":
+            return self._runtime_checks(step, ins)
         if kind not in self.KINDS:
             what = kind.replace("_", " ")
             article = "an" if what[:1] in "aeiou" else "a"
@@ -493,6 +501,34 @@ class Post:
         if kind == "circular":
             return self._arc_checks(step, ins)
         return []
+
+    def _runtime_checks(self, step: Step, ins: Any) -> list[Diagnostic]:
+        """A motion to a run-time target: written by a post that can (``"runtime_move"`` in
+        :attr:`KINDS`) from a template folder that says so (``runtime_targets: true``: a copy
+        made before olp wrote them would leave the motion out); a circular one as any arc.
+        What the language can name as a target is the brand's :meth:`check_instruction`."""
+        what = f"a {ins.motion} move to a target known only at run time (line {ins.span.line})"
+        if "runtime_move" not in self.KINDS:
+            why = f": {self.RUNTIME_REFUSAL}" if self.RUNTIME_REFUSAL else ""
+            msg = f"the {self.LANGUAGE} post cannot write {what}{why}"
+            return [_error("runtime_target", msg, step)]
+        if not self.manifest.runtime_targets:
+            msg = (
+                f"the {self.LANGUAGE} post's template folder {self.manifest.folder.name} does not "
+                f"declare that it writes {what} (runtime_targets: true in its post.yaml)"
+            )
+            hint = (
+                f"use the bundled {self.NAME} post, or copy its templates' run-time motion lines "
+                "and declare runtime_targets: true"
+            )
+            return [_error("runtime_target", msg, step, hint=hint)]
+        if ins.controller_settings and self.VERBATIM is None:
+            msg = (
+                f"the {self.LANGUAGE} post cannot write {what}: it runs with the settings that a "
+                "statement of another language, kept as written, sets before it"
+            )
+            return [_error("runtime_target", msg, step)]
+        return self._arc_checks(step, ins) if ins.motion == "circular" else []
 
     def _arc_checks(self, step: Step, ins: Any) -> list[Diagnostic]:
         """A circular move whose orientation rule or circular angle this language cannot

@@ -94,17 +94,20 @@ from typing import TYPE_CHECKING, Any, ClassVar
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from olp import ir
 from olp.compiled import PathBlock, Step, items_of
 from olp.diagnostics import Diagnostic
 from olp.geometry import inv
 from olp.posts.base import Filter, Post
-from olp.posts.fanuc_flow import FLOW_KINDS, lower
+from olp.posts.fanuc_flow import FLOW_KINDS, Unwritable, lower
 from olp.posts.fanuc_rows import LsColumns, column_moves, configured, mn_lines
+from olp.posts.flow_text import constant_int
 from olp.posts.numbers import NumberError, NumberFormat, Storage
 from olp.posts.rows import PostRows
+from olp.posts.runtime import targets as runtime_targets
 from olp.posts.sandbox import SafeText
 from olp.posts.text import ArgumentRule, CommentRule, NameRule
-from olp.posts.view import OPAQUE_KINDS, RowColumns
+from olp.posts.view import OPAQUE_KINDS, PostStep, RowColumns
 from olp.vendors.fanuc import (
     candidates,
     config_from_joints,
@@ -251,6 +254,19 @@ class LsMove:
 
 
 @dataclass(frozen=True, slots=True)
+class LsRuntime:
+    """A motion to a run-time target in ``/MN``: its frame and tool numbers and whether they
+    must be set before it (its motion line is :func:`ls_flow`'s, which knows the registers)."""
+
+    uf: int
+    ut: int
+    set_uf: bool
+    set_ut: bool
+    rows: ClassVar[bool] = False
+    target: ClassVar[None] = None  # no /POS entry: the register holds the position
+
+
+@dataclass(frozen=True, slots=True)
 class LsRows:
     """The LS motions of a run of linear moves (:mod:`olp.posts.rows`): one :class:`LsMove` per
     row, written by :func:`ls_rows_mn` and :func:`ls_rows_pos`."""
@@ -265,7 +281,7 @@ def ls_moves(
     steps: Sequence[PostStep | PostRows | RowColumns],
     robot: Any,
     options: Mapping[str, Any] | None = None,
-) -> dict[int, LsMove | LsRows | LsColumns]:
+) -> dict[int, LsMove | LsRows | LsColumns | LsRuntime]:
     """Template filter ``steps | ls_moves(robot, options)``: the LS motion of every motion of
     one file (template view steps, in order), by instruction index. Positions are numbered from
     1 in each file; ``UFRAME_NUM``/``UTOOL_NUM`` are set before the file's first motion, where
@@ -273,7 +289,7 @@ def ls_moves(
     in the text need not be the one that ran: :data:`JUMP_TARGETS`) or a call (which may set
     others: :data:`~olp.posts.view.OPAQUE_KINDS`). A toolpath's rows
     (:class:`~olp.posts.view.RowColumns`) are one :class:`~olp.posts.fanuc_rows.LsColumns`."""
-    out: dict[int, LsMove | LsRows | LsColumns] = {}
+    out: dict[int, LsMove | LsRows | LsColumns | LsRuntime] = {}
     last: tuple[int, int] | None = None
     number = 0
     for step in steps:
@@ -293,6 +309,12 @@ def ls_moves(
             out[step.index] = LsRows(step, moves)
             number = moves[-1].target.number
             last = (moves[-1].target.uf, moves[-1].target.ut)
+            continue
+        if step.kind == "runtime_move":
+            uf, ut = uframe_number(step.frame), utool_number(step.tool, options)
+            set_uf, set_ut = last is None or last[0] != uf, last is None or last[1] != ut
+            out[step.index] = LsRuntime(uf, ut, set_uf, set_ut)
+            last = (uf, ut)
             continue
         if step.joints is None:
             continue
@@ -328,7 +350,71 @@ def ls_flow(
     for node, message in lowered.problems:
         text = f"{_what(node)} cannot be written in LS: {message}"
         post.problems.append(Diagnostic("error", "flow", text, getattr(node, "span", None)))
-    return tuple(SafeText("\n".join(lines)) for lines in lowered.lines)
+    out = [SafeText("\n".join(lines)) for lines in lowered.lines]
+    for k, step in enumerate(steps):
+        if step.kind == "runtime_move" and isinstance(step, PostStep):
+            out[k] = SafeText("\n".join(_runtime_lines(post, step, lowered.variables)))
+    return tuple(out)
+
+
+def _runtime_lines(post: Post, step: PostStep, registers: Mapping[str, Any]) -> list[str]:
+    """The ``/MN`` lines of a motion to a run-time target: ``J PR[n:name] v% term``, ``L PR[n]
+    v mm/sec term``, ``C PR[a]`` / ``:  PR[b] ...`` (position registers as motion targets:
+    FANUC's motion instruction syntax "Motion Type, Position Type (P or PR), Speed,
+    Termination", e.g. ``L PR[2] 110mm/s CNT50``, from a public FANUC teach-pendant
+    programming course; an unverified point: olp assumes a Cartesian PR is read in the
+    UFRAME_NUM/UTOOL_NUM in effect, which it sets before the line as for any motion). A
+    target LS cannot name is an error on the motion (reported before rendering by
+    :meth:`FanucPost.check_program`)."""
+    ins: Any = step.instruction
+    post.current_step = step
+    try:
+        refs = [position_register(expr, registers, ins) for expr in runtime_targets(ins)]
+    except Unwritable as exc:
+        post.problems.append(Diagnostic("error", "runtime_target", str(exc), ins.span, step.index))
+        return []
+    term = termination(post, ins.zone)
+    if ins.motion == "joint":
+        return [f"J {refs[0]} {joint_percent(post, ins.speed)}% {term}    ;"]
+    speed = f"{linear_mm_per_s(post, ins.speed)}mm/sec {term}    ;"
+    if ins.motion == "linear":
+        return [f"L {refs[0]} {speed}"]
+    return [f"C {refs[0]}", f":  {refs[1]} {speed}"]
+
+
+def position_register(expr: Any, registers: Mapping[str, Any], ins: Any) -> str:
+    """``PR[n:name]`` of the position variable ``expr`` names (a name, or an element of an
+    array of them with a constant index: arrays take consecutive registers,
+    :class:`olp.posts.fanuc_flow.Registers`). :class:`~olp.posts.fanuc_flow.Unwritable` for
+    anything else: an element chosen at run time would need indirect addressing
+    (``PR[R[i]]``), which olp has not verified; a linear or circular move to a joint position
+    register is refused rather than left to the controller's conversion."""
+    base = expr.base if isinstance(expr, ir.Index) else expr
+    if not isinstance(base, ir.Name):
+        raise Unwritable(
+            "LS names a run-time target by a position register (a position variable of the "
+            "program); olp does not write this expression as one",
+            ins,
+        )
+    var = registers.get(base.name.upper())
+    if var is None or not var.position:
+        what = "not declared in the program" if var is None else "not a position"
+        raise Unwritable(f"{base.name} is {what}: no position register holds it", ins)
+    element = 1
+    if isinstance(expr, ir.Index):
+        index = constant_int(expr.indices[0]) if len(expr.indices) == 1 else None
+        if index is None or not 1 <= index <= var.size:
+            raise Unwritable(
+                f"the element of {base.name} is chosen at run time (or out of its range): LS "
+                "would need indirect addressing (PR[R[i]]), which olp has not verified",
+                ins,
+            )
+        element = index
+    if ins.motion != "joint" and var.kind != "cartesian":
+        raise Unwritable(
+            f"a {ins.motion} move needs a Cartesian position; {base.name} holds joints", ins
+        )
+    return str(var.ref(element))
 
 
 def _row_moves(
@@ -529,6 +615,7 @@ class FanucPost(Post):
     CALL_ARGUMENTS = ArgumentRule(re.compile(r"[+-]?(?:\d+(?:\.\d*)?|\.\d+)"), "numbers")
     NUMBERS: ClassVar[Mapping[str, NumberFormat]] = NUMBERS
     FILTERS: ClassVar[Mapping[str, Filter]] = FILTERS
+    KINDS: ClassVar[frozenset[str]] = Post.KINDS | {"runtime_move"}
 
     def __init__(self, manifest: Any) -> None:
         super().__init__(manifest)
@@ -540,9 +627,10 @@ class FanucPost(Post):
         (``L``/``C`` 1mm/sec, ``J`` 1%): the robot moves faster there than programmed and
         timed."""
         ins: Any = step.instruction
-        if step.skipped or ins.kind not in ("joint", "linear", "circular"):
+        kind = ins.motion if ins.kind == "runtime_move" else ins.kind
+        if step.skipped or kind not in ("joint", "linear", "circular"):
             return []
-        if ins.kind == "joint":
+        if kind == "joint":
             given, least, unit = ins.speed.joint * 100.0, 1, "%"
         else:
             given, least, unit = ins.speed.linear * 1000.0, 1, "mm/sec"
@@ -621,7 +709,35 @@ class FanucPost(Post):
         firsts = [m.step(0) if isinstance(m, PathBlock) else m for m in motions]
         out = _frame_checks(self, firsts, robot)
         out += _tool_checks(self, firsts, self.options)
-        return out + _joint_position_notes(self, motions, robot) + _flow_checks(self, compiled)
+        out += _joint_position_notes(self, motions, robot) + _flow_checks(self, compiled)
+        return out + _runtime_checks(self, compiled)
+
+
+def _runtime_checks(post: Post, compiled: CompiledProgram) -> list[Diagnostic]:
+    """``runtime_target`` (error): a motion to a run-time target whose target LS cannot name
+    as a position register (:func:`position_register`)."""
+    items = items_of(compiled.steps)  # a toolpath's rows stay a block: none is a run-time motion
+    runtime = [
+        s for s in items if isinstance(s, Step) and isinstance(s.instruction, ir.RuntimeMove)
+    ]
+    if not runtime:
+        return []
+    from olp.posts.flow import weave
+    from olp.posts.view import PostStep
+
+    steps = [PostStep(s.index, s.instruction.kind, "", s.instruction) for s in compiled.steps]
+    events = [(s.kind, s.instruction) for s in weave(compiled.program, steps)]
+    registers = lower(events, post.options, post.io_range).variables
+    out = []
+    for step in runtime:
+        ins: Any = step.instruction
+        try:
+            for expr in runtime_targets(ins):
+                position_register(expr, registers, ins)
+        except Unwritable as exc:
+            msg = f"the run-time target cannot be written in LS: {exc}"
+            out.append(Diagnostic("error", "runtime_target", msg, ins.span, step.index))
+    return out
 
 
 def _motions(compiled: CompiledProgram) -> list[Step | PathBlock]:

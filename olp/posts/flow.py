@@ -222,10 +222,12 @@ def _fresh_after_boundaries(steps: Sequence[PostStep], fresh: bool = False) -> I
             stale = set(_SETTINGS)
             yield step
             continue
-        if not isinstance(step.instruction, ir.MOTION_TYPES) or not stale:
+        ins = step.instruction
+        if not isinstance(ins, (*ir.MOTION_TYPES, ir.RuntimeMove)) or not stale:
             yield step
             continue
-        speed = "joint" if step.kind == "joint" else "linear"
+        kind = ins.motion if isinstance(ins, ir.RuntimeMove) else step.kind
+        speed = "joint" if kind == "joint" else "linear"
         fresh = speed in stale
         tool, frame, zone = ("tool" in stale), ("frame" in stale), ("zone" in stale)
         stale -= {"tool", "frame", "zone", speed}

@@ -61,6 +61,7 @@ from olp.ir_flow import FLOW_TYPES, Declare, leaves_and_blocks
 from olp.posts.base import Filter, Post
 from olp.posts.kuka_flow import (
     EVENT_KINDS,
+    flow_expr_problem,
     flow_problem,
     krl_call,
     krl_decl,
@@ -449,7 +450,7 @@ class KukaPost(Post):
     VERBATIM = "krl"
     WRITES_FLOW = True
     WRITES_ROUTINES = True
-    KINDS: ClassVar[frozenset[str]] = Post.KINDS | EVENT_KINDS
+    KINDS: ClassVar[frozenset[str]] = Post.KINDS | EVENT_KINDS | {"runtime_move"}
     NAME_RULE = NAME_RULE
     IO_RANGE = (1, 4096)
     CALL_ARGUMENTS = ArgumentRule(
@@ -511,6 +512,8 @@ class KukaPost(Post):
         * ``ptp_axis_values`` (warning): a PTP to a Cartesian target written as axis values,
           because Turn cannot tell two turns of an axis apart on this robot."""
         ins: Any = step.instruction
+        if ins.kind == "runtime_move":
+            return _runtime_checks(step.index, ins, self.options)
         if ins.kind != "joint" or step.skipped:
             return []
         return _joint_checks(step.index, ins, self.options) + _ambiguity(
@@ -551,6 +554,19 @@ class KukaPost(Post):
             )
             found.append(Diagnostic("error", "module_data", message, scoped[0].span))
         return found
+
+
+def _runtime_checks(index: int, ins: Any, options: Mapping[str, Any]) -> list[Diagnostic]:
+    """A motion to a run-time target is written back as ``PTP|LIN|CIRC <expression>``
+    (:func:`~olp.posts.kuka_flow.krl_expr`): every name in it must be a KRL name
+    (``runtime_target``, error); a PTP is checked like any (:func:`_joint_checks`)."""
+    out = []
+    for expr in (ins.target, ins.via):
+        problem = None if expr is None else flow_expr_problem(expr)
+        if problem is not None:
+            message = f"the run-time target cannot be written in KRL: {problem}"
+            out.append(Diagnostic("error", "runtime_target", message, ins.span, index))
+    return out + (_joint_checks(index, ins, options) if ins.motion == "joint" else [])
 
 
 def _ambiguity(robot: Any, step: Step) -> list[Diagnostic]:

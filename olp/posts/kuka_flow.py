@@ -231,6 +231,12 @@ def _exprs(node: Any) -> list[Any]:
     return [e for e in found if e is not None]
 
 
+def flow_expr_problem(expr: Any) -> str | None:
+    """Why ``expr`` cannot be written as a KRL expression (a name that is not a KRL name, a
+    constant KRL cannot hold), or None."""
+    return _expr_problem(expr)
+
+
 def _expr_problem(expr: Any) -> str | None:
     if isinstance(expr, ir.Constant):
         return _constant_problem(expr)

@@ -34,6 +34,9 @@ The manifest says::
                                       # data in the data list, external names not declared);
                                       # default false: a folder copied before, which a post
                                       # that checks it refuses for a program with module data
+    runtime_targets: true             # the templates write motions to run-time targets
+                                      # (kind runtime_move; default false: a folder copied
+                                      # before would leave them out, so the post refuses them)
     options: {...}                    # free-form: templates see them as `options`, and so does
                                       # the post class
 
@@ -78,6 +81,7 @@ class PostManifest:
     flow: bool = False
     routines: bool = False
     module_data: bool = False
+    runtime_targets: bool = False
 
 
 def load_manifest(folder: Path) -> PostManifest:
@@ -95,8 +99,10 @@ def load_manifest(folder: Path) -> PostManifest:
     frames_in = str(raw.get("frames_in", "world"))
     if frames_in not in FRAMES_IN:
         raise PostError(f"{path}: frames_in must be one of {', '.join(FRAMES_IN)}")
-    keys = ("rows", "accelerations", "flow", "module_data", "routines")
-    rows, accelerations, flow, module_data, routines = (_flag(raw, key, path) for key in keys)
+    keys = ("rows", "accelerations", "flow", "module_data", "routines", "runtime_targets")
+    rows, accelerations, flow, module_data, routines, runtime_targets = (
+        _flag(raw, key, path) for key in keys
+    )
     return PostManifest(
         name=str(raw.get("name", folder.name)),
         vendor=str(raw.get("vendor", "")),
@@ -114,6 +120,7 @@ def load_manifest(folder: Path) -> PostManifest:
         flow=flow,
         module_data=module_data,
         routines=routines,
+        runtime_targets=runtime_targets,
     )
 
 

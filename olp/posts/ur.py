@@ -429,6 +429,13 @@ def _flow_tokens(nodes: Sequence[Any], counter: Iterator[int]) -> Iterator[int |
 class UrPost(Post):
     """Universal Robots URScript; see the module docstring."""
 
+    RUNTIME_REFUSAL = (
+        "URScript would name it by a pose variable (movel(p)), and olp's URScript post "
+        "declares none: KRL gives a position in mm and degrees with Euler angles, URScript in "
+        "metres with a rotation vector, and olp does not convert a variable's value "
+        "(olp.posts.ur_flow)"
+    )
+
     NAME = "ur"
     VENDOR = "ur"
     LANGUAGE = "URScript"

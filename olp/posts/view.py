@@ -12,7 +12,7 @@ import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol, TypedDict
 
 import numpy as np
 from numpy.typing import NDArray
@@ -26,6 +26,7 @@ from olp.ir import (
     CircularMove,
     Frame,
     JointMove,
+    RuntimeMove,
     Tool,
     Zone,
 )
@@ -125,6 +126,15 @@ class PostStep:
     * ``duration`` (added): seconds, from the timing pass (0 when it did not run).
     * ``vendor`` (added): per-motion values from the post's ``step_values`` (KUKA ``status``,
       ``turn``; ABB ``confdata``; Fanuc ``config``), empty for posts without them.
+
+    Motions to run-time targets (kind ``runtime_move``, ``instruction`` an
+    :class:`olp.ir.RuntimeMove`: ``instruction.motion`` says joint, linear or circular and
+    ``instruction.target`` / ``instruction.via`` are expressions): ``tool``, ``frame``,
+    ``tool_name``, ``frame_name``, ``frame_pose`` and the ``new_*`` flags as for any motion (the
+    settings it runs with are written before it); ``motion`` is 0, and there is no ``joints``,
+    ``pose`` or ``name``. One that runs with the controller's settings
+    (``instruction.controller_settings``) has no tool, frame or flags: nothing is written before
+    it, and the motion after it writes every setting.
 
     Comments: ``comment`` (added), the text as the post's comment lines (escaped: a line break
     of the text starts another comment line, never a statement).
@@ -421,6 +431,10 @@ class ProgramView:
             step = item
             motion = self.motions.get(step.index)
             if motion is None:
+                if _written_runtime(step):
+                    tools[step.index], frames[step.index] = self._tool_frame(
+                        step.tool, step.frame, self._frame_pose(step.frame), names, by_object
+                    )
                 continue
             via = names.take(via_pattern.format(n=motion.number)) if motion.via is not None else ""
             points[step.index] = (names.take(point_pattern.format(n=motion.number)), via)
@@ -512,7 +526,13 @@ class ProgramView:
                     out.append(self._rows(step, names, last))
                 continue
             ins = step.instruction
-            if not isinstance(ins, MOTION_TYPES):
+            if isinstance(ins, RuntimeMove) and ins.controller_settings:
+                out.append(PostStep(step.index, ins.kind, ins.span.location, ins))
+                last.clear()  # it runs with the controller's settings: the next sets its own
+            elif isinstance(ins, RuntimeMove):
+                if _written_runtime(step):
+                    out.append(self._runtime_step(step, names, last))
+            elif not isinstance(ins, MOTION_TYPES):
                 lines = self.post.comment_lines(ins.text) if ins.kind == "comment" else ()
                 out.append(PostStep(step.index, ins.kind, ins.span.location, ins, comment=lines))
                 if ins.kind in OPAQUE_KINDS:
@@ -552,22 +572,30 @@ class ProgramView:
             new_zone,
         )
 
+    def _runtime_step(self, step: Step, names: Allocation, last: dict[str, Any]) -> PostStep:
+        """A motion to a run-time target (kind ``runtime_move``): its tool, frame and change
+        flags as any motion's, so that the settings it runs with are written before it; no
+        point, pose or joints (the target is ``instruction.target``, an expression)."""
+        ins: Any = step.instruction
+        flags = _settings_changed(step, ins.motion == "joint", last)
+        assert step.frame is not None
+        return PostStep(
+            step.index,
+            ins.kind,
+            ins.span.location,
+            ins,
+            tool=step.tool,
+            frame=step.frame,
+            tool_name=names.tools[step.index].name,
+            frame_name=names.frames[step.index].name,
+            frame_pose=self._frame_pose(step.frame),
+            **flags,
+        )
+
     def _motion_step(self, step: Step, names: Allocation, last: dict[str, Any]) -> PostStep:
         ins: Any = step.instruction
         motion = self.motions[step.index]
-        new_tool = _changed_object(last, "tool", step.tool)
-        new_frame = _changed_object(last, "frame", step.frame)
-        new_zone = _changed_value(last, "zone", ins.zone)
-        joint = isinstance(ins, JointMove)
-        speed = ins.speed
-        new_joint_speed = joint and _changed_value(
-            last, "joint_speed", (speed.joint, speed.joint_acceleration)
-        )
-        new_linear_speed = not joint and _changed_value(
-            last,
-            "linear_speed",
-            (speed.linear, speed.angular, speed.linear_acceleration, speed.angular_acceleration),
-        )
+        flags = _settings_changed(step, isinstance(ins, JointMove), last)
         point, via = names.points[step.index]
         return PostStep(
             step.index,
@@ -589,12 +617,40 @@ class ProgramView:
             base_pose=motion.base_pose,
             duration=step.duration,
             vendor=motion.vendor,
-            new_tool=new_tool,
-            new_frame=new_frame,
-            new_zone=new_zone,
-            new_joint_speed=new_joint_speed,
-            new_linear_speed=new_linear_speed,
+            **flags,
         )
+
+
+class _Flags(TypedDict):
+    new_tool: bool
+    new_frame: bool
+    new_zone: bool
+    new_joint_speed: bool
+    new_linear_speed: bool
+
+
+def _settings_changed(step: Step, joint: bool, last: dict[str, Any]) -> _Flags:
+    """The ``new_*`` flags of a motion (its settings against ``last``, which records them)."""
+    ins: Any = step.instruction
+    speed = ins.speed
+    new_tool = _changed_object(last, "tool", step.tool)
+    new_frame = _changed_object(last, "frame", step.frame)
+    new_zone = _changed_value(last, "zone", ins.zone)
+    new_joint_speed = joint and _changed_value(
+        last, "joint_speed", (speed.joint, speed.joint_acceleration)
+    )
+    new_linear_speed = not joint and _changed_value(
+        last,
+        "linear_speed",
+        (speed.linear, speed.angular, speed.linear_acceleration, speed.angular_acceleration),
+    )
+    return _Flags(
+        new_tool=new_tool,
+        new_frame=new_frame,
+        new_zone=new_zone,
+        new_joint_speed=new_joint_speed,
+        new_linear_speed=new_linear_speed,
+    )
 
 
 OPAQUE_KINDS = frozenset({"call", "verbatim"})
@@ -621,6 +677,15 @@ def _changed_value(last: dict[str, Any], key: str, value: Any) -> bool:
 def _written_motion(step: Step) -> bool:
     motion = isinstance(step.instruction, MOTION_TYPES)
     return motion and not step.skipped and step.joints is not None
+
+
+def _written_runtime(step: Step) -> bool:
+    """Whether a motion to a run-time target is written with settings: its tool and frame
+    resolved (one that runs with the controller's settings has none)."""
+    tool, frame = step.tool, step.frame
+    return (
+        tool is not None and tool.pose is not None and frame is not None and frame.pose is not None
+    )
 
 
 def _is_null(obj: Tool | Frame, null: Tool | Frame) -> bool:

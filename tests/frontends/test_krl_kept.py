@@ -11,7 +11,6 @@ import olp
 from olp import ir
 from olp.frontends.bundled import KrlOptions
 from olp.frontends.krl import load_krl
-from olp.ir_flow import leaves_and_blocks
 
 REPO = Path(__file__).resolve().parents[2]
 STATION = REPO / "stations" / "kr6_milling_cell.yaml"
@@ -180,17 +179,14 @@ def test_a_motion_to_a_variable_given_pos_act_is_kept_as_no_motion(tmp_path: Pat
 
 
 def test_a_held_pos_act_is_stale_after_a_motion(tmp_path: Path) -> None:
-    """After a motion, pAct is a position only the run knows: the SPTP to it is kept as written
-    with a warning (not checked), not taken as "no motion". The PTP before it has written the
-    settings it runs with (its WITH sets the rest)."""
+    """After a motion, pAct is a position only the run knows: the SPTP to it is a motion to a
+    run-time target (not checked, with a warning from the passes), not taken as "no motion"."""
     path = tmp_path / "here.src"
     path.write_text(HERE_PROGRAM.format(between="PTP XHOME\n"))
     result = load_krl(path, CORPUS / "System" / "$config.dat")
-    (kept,) = [n for n in leaves_and_blocks(result.program.instructions) if n.kind == "verbatim"]
-    assert kept.span.line == 5 and kept.text.startswith("SPTP pAct")
-    assert "known only when the program runs" in kept.reason and "pAct" in kept.reason
-    (note,) = [n for n in result.notes if n.span.line == 5]
-    assert "cannot know offline" in note.message
+    (moved,) = [n for n in result.program if isinstance(n, ir.RuntimeMove)]
+    assert moved.span.line == 5 and moved.target == ir.Name(name="pAct", span=moved.target.span)
+    assert "pAct" in moved.reason
 
 
 @pytest.mark.parametrize(
@@ -202,12 +198,14 @@ def test_a_held_pos_act_is_stale_after_a_motion(tmp_path: Path) -> None:
 )
 def test_a_held_pos_act_is_stale_after_anything_that_may_move(tmp_path: Path, between: str) -> None:
     """After a block or a call that may move the robot, pAct is known only when the program
-    runs, and olp cannot tell which tool, base and speed the controller holds there: an
-    error, not a motion written with settings nobody checked."""
+    runs: a motion to a run-time target with the settings in effect (its WITH's), which the
+    KRL post writes before it (before, olp stopped: the posts wrote settings only before the
+    motions they modelled)."""
     path = tmp_path / "here.src"
     path.write_text(HERE_PROGRAM.format(between=between))
-    with pytest.raises(olp.errors.ParseError, match=r"pAct.*cannot write the motion settings"):
-        load_krl(path, CORPUS / "System" / "$config.dat")
+    program = load_krl(path, CORPUS / "System" / "$config.dat").program
+    (moved,) = [n for n in program if isinstance(n, ir.RuntimeMove)]
+    assert moved.motion == "joint" and moved.speed.joint == pytest.approx(0.1)
 
 
 @pytest.mark.parametrize("again", ["$TOOL = $NULLFRAME", "$TOOL = TOOL_DATA[1]"])

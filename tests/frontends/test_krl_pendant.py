@@ -190,16 +190,16 @@ def test_pick_lists_every_ignored_line_with_a_reason(pick: KrlResult) -> None:
     assert [line for line, _ in by_file["robot_config.dat"]] == [14, 15, 38]  # STRUC ENUM SIGNAL
 
 
-def test_pick_without_config_says_what_is_missing() -> None:
-    with pytest.raises(ParseError) as info:
-        load_krl(PICK)
-    error = info.value
-    assert error.span is not None and (Path(error.span.file).name, error.span.line) == (
-        "pendant_pick.src",
-        26,
-    )
-    assert "FDAT_ACT" in error.message and "FHOME" in error.message
-    assert error.hint is not None and "config_dat" in error.hint
+def test_pick_without_config_moves_home_with_the_controller_settings() -> None:
+    """Without ``$config.dat`` the two HOME folds (``FDAT_ACT=FHOME``, ``BAS(#PTP_PARAMS)``,
+    ``PTP XHOME``) are motions to a target olp does not know, with the settings the kept BAS
+    sets, and the reason names the missing file (before, olp stopped at the first one); the
+    taught points between them are modelled."""
+    result = load_krl(PICK)
+    homes = [n for n in result.program.expanded() if isinstance(n, ir.RuntimeMove)]
+    assert [(n.span.line, n.controller_settings) for n in homes] == [(28, True), (81, True)]
+    assert all("$config.dat" in n.reason for n in homes)
+    assert len(list(result.program.motions())) == 4
 
 
 def test_tool_and_base_numbers_without_config_are_references(tmp_path: Path) -> None:
@@ -561,8 +561,17 @@ def test_home(config: KrlData) -> None:
     np.testing.assert_allclose(first.target.joints, np.radians([0, -90, 90, 0, 30, 0]))
     np.testing.assert_array_equal(first.target.joints, second.target.joints)
     assert "$machine.dat" in parse_error("PTP $H_POS").message
-    error = parse_error("PTP XHOME")
-    assert "XHOME is not declared" in error.message
+
+
+def test_home_without_config_dat_is_a_motion_to_a_run_time_target() -> None:
+    """Every KR C4 ``$config.dat`` declares XHOME; without it olp keeps ``PTP XHOME`` as a
+    motion to a target it does not know (never a guessed home), and the reason names the
+    missing ``$config.dat``. Another undeclared name stays an error."""
+    (home,) = [n for n in parse("PTP XHOME").program if isinstance(n, ir.RuntimeMove)]
+    assert home.motion == "joint" and home.target == ir.Name(name="XHOME", span=home.target.span)
+    assert "$config.dat" in home.reason and "--config-dat" in home.reason
+    error = parse_error("PTP XHOMEX")
+    assert "XHOMEX is not declared" in error.message
     assert error.hint is not None and "config_dat" in error.hint
 
 

@@ -1,10 +1,12 @@
 """Values only the run knows, as real KR C4 programs use them (issue 15): motions to positions
 computed from $POS_ACT, BAS with variables, PTP ... C_DIS, open array declarations. What olp
-cannot know offline is kept as written with a warning, never dropped and never guessed."""
+cannot know offline is kept (a motion to a run-time target as :class:`olp.ir.RuntimeMove`, a
+statement as written) with a warning, never dropped and never guessed."""
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -21,6 +23,7 @@ BACKUP_CONFIG = REPO / "tests" / "corpus" / "krc" / "R1" / "System" / "$config.d
 CONFIG = REPO / "examples" / "robot_config.dat"
 HOME = "PTP {A1 0,A2 -90,A3 90,A4 0,A5 30,A6 0}"
 FRAMES = ("$BASE = BASE_DATA[1]", "$TOOL = TOOL_DATA[1]")
+LIN = "LIN {X 500,Y 0,Z 400,A 0,B 90,C 0}"
 
 
 @pytest.fixture(scope="module")
@@ -36,19 +39,23 @@ def kept(result: KrlResult) -> list[ir.Verbatim]:
     return [n for n in leaves_and_blocks(result.program.instructions) if isinstance(n, ir.Verbatim)]
 
 
+def runtime(result: KrlResult) -> list[ir.RuntimeMove]:
+    nodes = leaves_and_blocks(result.program.instructions)
+    return [n for n in nodes if isinstance(n, ir.RuntimeMove)]
+
+
 OFFSET = (
     "DEF lift( )\nDECL E6POS above\nPTP XHOME\nabove = $POS_ACT\n"
     "above.Z = above.Z + 50\nPTP above\nPTP XHOME\nEND\n"
 )
 
 
-def test_a_motion_to_an_offset_of_the_current_position_is_kept_with_a_warning(
+def test_a_motion_to_an_offset_of_the_current_position_is_a_run_time_motion(
     config: KrlData,
 ) -> None:
     """``p = $POS_ACT`` then ``p.Z = p.Z + 50`` and ``LIN p``: the target is where the robot
-    happens to stand, plus 50 mm. Kept as written, with a warning, and the motions after it are
-    still lowered. The LIN before it has the same tool, base, speed and approximation: the
-    output writes them there, so the kept LIN runs with them."""
+    happens to stand, plus 50 mm: a :class:`~olp.ir.RuntimeMove` to the expression ``above``
+    with the settings in effect, and the motions after it are still lowered."""
     result = parse(
         config,
         "DECL E6POS above",
@@ -61,35 +68,39 @@ def test_a_motion_to_an_offset_of_the_current_position_is_kept_with_a_warning(
         "LIN above",
         HOME,
     )
-    (lin,) = kept(result)
-    assert (lin.span.line, lin.text) == (10, "LIN above")
-    assert "known only when the program runs" in lin.reason and "$POS_ACT" in lin.reason
-    (note,) = [n for n in result.notes if n.span.line == 10]
-    assert note.message.startswith("LIN to a target olp cannot know offline")
+    assert kept(result) == []
+    (lin,) = runtime(result)
+    assert (lin.span.line, lin.motion) == (10, "linear")
+    assert lin.target == ir.Name(name="above", span=lin.target.span)
+    assert "$POS_ACT" in lin.reason and lin.speed.linear == pytest.approx(0.2)
+    assert lin.tool.name == "TOOL_DATA[1]" or lin.tool.number == 1
     assert [m.span.line for m in result.program.motions()] == [6, 7, 11]
 
 
 @pytest.mark.parametrize(
-    ("before", "why"),
+    ("before", "check"),
     [
-        ((HOME,), "of another kind"),
-        (("LIN {X 500,Y 0,Z 400,A 0,B 90,C 0}", "$VEL.CP = 0.1"), "speed differs"),
-        (("LIN {X 500,Y 0,Z 400,A 0,B 90,C 0}", "$BASE = BASE_DATA[2]"), "frame differs"),
-        (("LIN {X 500,Y 0,Z 400,A 0,B 90,C 0}", "Foo()"), "call at line"),
-        (("IF $IN[1] THEN", "LIN {X 500,Y 0,Z 400,A 0,B 90,C 0}", "ENDIF"), "if at line"),
+        ((HOME,), lambda m: m.speed.linear == pytest.approx(0.2)),
+        (("LIN {X 500,Y 0,Z 400,A 0,B 90,C 0}", "$VEL.CP = 0.1"), lambda m: m.speed.linear == 0.1),
+        (
+            ("LIN {X 500,Y 0,Z 400,A 0,B 90,C 0}", "$BASE = BASE_DATA[2]"),
+            lambda m: m.frame.number == 2,
+        ),
+        (("LIN {X 500,Y 0,Z 400,A 0,B 90,C 0}", "Foo()"), lambda m: m.tool.number == 1),
+        (("IF $IN[1] THEN", "LIN {X 500,Y 0,Z 400,A 0,B 90,C 0}", "ENDIF"), lambda m: True),
     ],
 )
-def test_a_run_time_motion_whose_settings_the_output_does_not_hold_is_refused(
-    config: KrlData, before: tuple[str, ...], why: str
+def test_a_run_time_motion_runs_with_the_settings_in_effect_wherever_it_stands(
+    config: KrlData, before: tuple[str, ...], check: Any
 ) -> None:
-    """The posts write tool, base, speed and approximation only before the motions olp models,
-    and only where they change: a motion kept as written after other settings, a call or a
-    block would run with settings nobody checked. olp stops, naming the line and why."""
+    """A run-time motion carries the tool, base, speed and approximation in effect, like any
+    motion, so the posts write them before it: after another kind of motion, other settings,
+    a call or a block it is lowered (before, olp stopped there, because it kept the line as
+    written and the posts wrote settings only before the motions they modelled)."""
     here = ["p = $POS_ACT", "p.Z = p.Z + 10"]
     body = ["DECL E6POS p", *FRAMES, "$VEL.CP = 0.2", HOME, *before, *here, "LIN p"]
-    with pytest.raises(ParseError, match="cannot write the motion settings") as info:
-        parse(config, *body)
-    assert why in info.value.message and info.value.span.line == len(body) + 1
+    (lin,) = runtime(parse(config, *body))
+    assert lin.span.line == len(body) + 1 and check(lin)
 
 
 @pytest.mark.parametrize(
@@ -108,11 +119,10 @@ def test_the_kuka_post_writes_a_run_time_motion_back_and_the_others_refuse_it(
     if refused is None:
         assert result.ok and not errors
         assert "PTP above" in result.files["lift.src"].splitlines()
-    else:
-        assert not result.ok
-        (verbatim,) = [d for d in errors if d.kind == "verbatim"]
-        assert verbatim.span is not None and verbatim.span.line == 6
-        assert "'PTP above'" in verbatim.message
+    else:  # none of them can read where the robot stands ($POS_ACT, line 4)
+        assert not result.ok and not result.files
+        assert any(d.span is not None and d.span.line == 4 for d in errors)
+        assert all(d.kind in ("flow", "runtime_target") for d in errors)
 
 
 def test_a_name_declared_nowhere_is_still_an_error(config: KrlData) -> None:
@@ -217,8 +227,8 @@ def test_held_measured_axes_are_no_motion(config: KrlData) -> None:
 def test_a_constant_for_loop_over_run_time_positions_is_kept_once_per_pass(
     config: KrlData,
 ) -> None:
-    """A constant FOR loop is still unrolled when its body holds a run-time target: the LIN
-    is kept once per pass."""
+    """A constant FOR loop is still unrolled when its body holds a run-time target: the PTP
+    is a run-time motion once per pass."""
     result = parse(
         config,
         "DECL E6POS p",
@@ -232,8 +242,8 @@ def test_a_constant_for_loop_over_run_time_positions_is_kept_once_per_pass(
         "ENDFOR",
         HOME,
     )
-    ptps = [n for n in result.program.instructions if isinstance(n, ir.Verbatim)]
-    assert [(n.span.line, n.text) for n in ptps] == [(10, "PTP p"), (10, "PTP p")]
+    ptps = runtime(result)
+    assert [(n.span.line, n.motion) for n in ptps] == [(10, "joint"), (10, "joint")]
     assert [m.span.line for m in result.program.motions()] == [6, 12]
 
 

@@ -41,6 +41,9 @@ UR_CELL = "stations/ur5e_screw_cell.yaml"
 FANUC_CELL = "stations/fanuc_m20ia_weld_cell.yaml"
 TRANSPILE = "tests/posts/transpile.src"
 FLOW = "tests/posts/flow"
+RUNTIME = "tests/posts/runtime/runtime_targets.src"
+"""Motions to run-time targets (a path array indexed in loops), with their settings written
+before each, also after a call."""
 
 USERS_JOBS: dict[str, tuple[str, str, dict[str, Any]]] = {
     "job1_weld_polygon": (KUKA_CELL, "examples/weld_polygon.py", {}),
@@ -75,6 +78,7 @@ CASES: dict[tuple[str, str], tuple[str, str, dict[str, Any]]] = {
     ("fanuc", "flow_cycle"): (FANUC_CELL, "tests/posts/fanuc_flow/cycle.src", {}),
     ("fanuc", "flow_mixed"): (FANUC_CELL, "tests/posts/fanuc_flow/mixed.src", {}),
     **{(post, "weld_rounded"): (KUKA_CELL, "examples/weld_rounded.src", {}) for post in ENDINGS},
+    **{(post, "runtime_targets"): (KUKA_CELL, RUNTIME, {}) for post in ("kuka", "abb")},
     **{
         (post, job): (KUKA_CELL, f"{FLOW}/{job}.src", {})
         for post, job in [

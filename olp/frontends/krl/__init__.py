@@ -44,21 +44,24 @@ What is lowered
   CONT since KSS 8.2: the distance criterion) uses ``$APO.CDIS`` too. Before any ``$APO.CDIS``
   a motion stops exactly, with a note.
 * **Motions to run-time targets** (a position computed from a function's result, an input, a
-  routine parameter or a path-dependent value, all of its names declared) are kept as written
-  (:class:`olp.ir.Verbatim`) with a warning: the controller computes the target, olp checks
-  nothing of that motion, and the next motion starts where olp does not know. The posts write
-  tool, base, speed and approximation only before the motions olp models, and only where they
-  change: so such a motion is kept only right after a modelled motion of its kind (PTP, or
-  LIN/CIRC) with the same settings, in the same straight stretch (no block, label, call,
-  statement kept as written or system-variable assignment between); elsewhere it is an error
-  saying why. A name declared
-  nowhere stays an error naming the data list that would declare it.
+  routine parameter or a path-dependent value, all of its names declared: ``LIN xPath[i]``,
+  ``PTP fnGetPos()``) become :class:`olp.ir.RuntimeMove`: the target stays the expression, the
+  tool, base, speed and approximation are those in effect (the posts write them before it as
+  before any motion), and ``reason`` says why olp cannot know the target. The passes warn that
+  they cannot check or time it, and the next motion starts where olp does not know. So does
+  ``PTP XHOME`` (or ``XHOME1`` .. ``XHOME6``) when no ``$config.dat`` was given: every KR C4's
+  ``$config.dat`` declares it, its value is the cell's, and olp never guesses it (the reason
+  names the missing file). A ``_REL`` motion by run-time offsets is kept as written
+  (:class:`olp.ir.Verbatim`), and only right after a modelled motion of its kind with the same
+  settings, in the same straight stretch (elsewhere an error saying why). A name declared
+  nowhere else stays an error naming the data list that would declare it.
 * **BAS with run-time values** (``BAS(#PTP_PARAMS, v)``, or ``PDAT_ACT`` given a parameter) is
-  kept as written; the settings it sets are ambiguous until set again, and a modelled motion
-  after it in the same straight stretch is an error (the output would not write the settings
-  that BAS changed behind its back). A settings routine without motions builds.
+  kept as written; the settings it sets are ambiguous until set again, and a motion (a
+  run-time one too) after it in the same straight stretch is an error (the output would not
+  write the settings that BAS changed behind its back). A settings routine without motions builds.
 * **Unrolled FOR loops** write ``counter = n`` before a pass whose output reads the counter
-  (a statement kept as written such as ``LIN xPath[i]``, ``r[i] = $OV_PRO``, ``Foo(i)``).
+  (a run-time motion such as ``LIN xPath[i]``, a statement kept as written such as
+  ``r[i] = $OV_PRO``, ``Foo(i)``).
 * **Speeds.** ``$VEL.CP`` (m/s) -> ``Speed.linear``; ``$VEL_AXIS[i]``/``$ACC_AXIS[i]`` (%) ->
   ``Speed.joint``/``joint_acceleration`` as the **minimum** over the axes set so far (one
   fraction cannot hold per-axis values; the slowest axis bounds a synchronised PTP).
@@ -131,7 +134,8 @@ Nothing is dropped silently: every statement olp recognised but did not lower is
 the program's own as warnings). Statements that matter to the controller but that olp does not
 model (motion parameters such as ``$ACC.CP``, ``$VEL.ORI1``, ``$ADVANCE``; ``SET_CD_PARAMS``,
 ``PULSE``, ``HALT``, ``BRAKE``, ``CONTINUE``, ``ON_ERROR_PROCEED``, ``RESUME``, motions to
-``$POS_ACT``) are kept in the program as :class:`olp.ir.Verbatim`: the KRL post writes them
+``$POS_ACT``, ``_REL`` motions by run-time offsets) are kept in the program as
+:class:`olp.ir.Verbatim`: the KRL post writes them
 back, other posts stop on them. ``$ORI_TYPE``/``$CIRC_TYPE`` are motion settings (the arcs'
 orientation rule); for linear moves olp notes at each one that it does not model them.
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from olp import ir
 from olp.frontends.krl.ast import (
     Aggregate,
     Assign,
@@ -100,6 +101,9 @@ class InlineForms(Core):
         the motion settings it sets are unknown from here on, so a motion that relies on them
         is an error, and a module without one (a settings routine) builds."""
         self._keep(stmt, f"BAS #{command} with a value known only at run time ({reason})")
+        kept = self.out[-1]
+        assert isinstance(kept, ir.Verbatim)
+        self.kept_bas = (kept, self.state)  # the motion right after it may run with it
         ambiguous: dict[str, str] | None = getattr(self, "ambiguous", None)
         why = f"BAS(#{command}) at line {stmt.span.line} sets them from run-time values"
         for field_name in _BAS_SETS[command]:

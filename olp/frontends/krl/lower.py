@@ -47,6 +47,7 @@ from olp.frontends.krl.ast import (
 )
 from olp.frontends.krl.data import OTHER_REASONS, KrlData, visible_globals
 from olp.frontends.krl.events import Events
+from olp.frontends.krl.fast import materialise
 from olp.frontends.krl.flow import (
     PastFor,
     assigned_names,
@@ -219,6 +220,10 @@ class _Lowering(Motions, Events):
             self._ignore(stmt, f"not reached: the GOTO at line {self.jumped} jumps away")
             return
         if self.ambiguous and isinstance(stmt, MotionStmt | FastMotion):
+            motion = materialise(stmt) if isinstance(stmt, FastMotion) else stmt
+            if self._controller_settings_motion(motion):
+                self.ctx.spend(stmt)
+                return
             reasons = "; ".join(sorted(set(self.ambiguous.values())))
             raise self._error(
                 f"olp cannot tell which motion settings this motion runs with: {reasons}",

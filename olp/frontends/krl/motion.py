@@ -25,6 +25,7 @@ from olp.frontends.krl.ast import (
     Var,
 )
 from olp.frontends.krl.fast import materialise, row_motions
+from olp.frontends.krl.flow import to_expr
 from olp.frontends.krl.inline import InlineForms
 from olp.frontends.krl.state import (
     DEFAULT_VEL_CP,
@@ -190,10 +191,13 @@ class Motions(InlineForms):
                 stmt.frame_option.span,
             )
         runtime = None if self.ctx.probing_for else self._runtime_target(stmt)
-        if runtime is not None:
+        if runtime is not None and relative:
             self._keep_runtime_motion(stmt, base, runtime)
         elif stmt.with_clause:
-            self._with_motion(stmt, base, relative)
+            self._with_motion(stmt, base, relative, runtime)
+        elif runtime is not None:
+            self._note_after_with(stmt)
+            self._runtime_motion(stmt, base, runtime)
         else:
             self._note_after_with(stmt)
             self._plain_motion(stmt, base, relative)
@@ -205,8 +209,10 @@ class Motions(InlineForms):
         A run-time target (or a component of an inline aggregate) is one olp cannot evaluate
         although every name it depends on is declared: a position computed from a function's
         result, an input, a parameter, a path-dependent value, a controller variable
-        (``joint = $AXIS_ACT_MEAS``). A name declared nowhere is left to the usual error, which
-        tells the user which data list or ``$config.dat`` is missing."""
+        (``joint = $AXIS_ACT_MEAS``). So is a name of :data:`CONFIG_DAT_POINTS` (``XHOME``)
+        when no ``$config.dat`` was given: every KR C4's ``$config.dat`` declares it, but its
+        value is the cell's, which olp never guesses. Any other name declared nowhere is left
+        to the usual error, which tells the user which data list is missing."""
         for expr in stmt.targets:
             parts = [m.value for m in expr.members] if isinstance(expr, Aggregate) else [expr]
             for part in parts:
@@ -214,12 +220,116 @@ class Motions(InlineForms):
                 if self._runtime(value):
                     assert isinstance(value, Unknown)
                     return value.reason
+                missing = self._config_point_missing(part, value)
+                if missing is not None:
+                    return missing
+        return None
+
+    def _config_point_missing(self, part: Expr, value: Any) -> str | None:
+        """The reason for a motion to a :data:`CONFIG_DAT_POINTS` name without ``$config.dat``
+        (see :meth:`_runtime_target`), else None."""
+        if not (isinstance(value, Unknown) and value.missing) or self.ctx.config is not None:
+            return None
+        if not isinstance(part, Var) or part.selectors:
+            return None
+        if part.name.upper() not in CONFIG_DAT_POINTS:
+            return None
+        return (
+            f"{part.name} is declared in the controller's $config.dat, which was not given "
+            "with --config-dat; olp does not guess its value"
+        )
+
+    def _runtime_motion(self, stmt: MotionStmt, base: str, reason: str) -> None:
+        """A motion to a run-time target as :class:`~olp.ir.RuntimeMove`: the target stays an
+        expression, the settings are those in effect (a post writes them before it as before
+        any motion); the passes say what they cannot check, and the next motion starts where
+        olp does not know."""
+        zone = self._zone(stmt, base)
+        fields = self._fields(stmt, zone)
+        if base != "PTP":
+            self._note_default_speed(stmt)
+        if base == "CIRC":
+            fields.update(self._arc_fields(stmt))
+        elif base == "LIN":
+            self._note_line_orientation(stmt)
+        self._after_kept_settings(stmt.span)
+        self.out.append(
+            ir.RuntimeMove(
+                motion=_RUNTIME_KINDS[base],
+                target=self._target_expr(stmt.targets[-1]),
+                via=self._target_expr(stmt.targets[0]) if base == "CIRC" else None,
+                reason=reason,
+                **fields,
+            )
+        )
+        self.track.lose(f"the {stmt.keyword} at line {stmt.span.line} goes to a run-time target")
+
+    def _target_expr(self, expr: Expr) -> ir.Expr:
+        converted = to_expr(expr, self._input_index)
+        assert converted is not None
+        return converted
+
+    def _controller_settings_motion(self, stmt: MotionStmt) -> bool:
+        """The motion right after a BAS kept as written (its values known only at run time, a
+        ``$config.dat`` olp was not given among them: the pendant's ``FDAT_ACT=FHOME``,
+        ``BAS(#PTP_PARAMS,100)``, ``PTP XHOME``), in the same straight stretch, when that BAS
+        is all that leaves its settings unknown and no setting was assigned since it: a
+        :class:`~olp.ir.RuntimeMove` that runs with the controller's settings
+        (``controller_settings``: the KRL post writes no setting before it, so the BAS's
+        hold), its target an expression. Not for a _REL or WITH
+        motion. Returns whether it lowered ``stmt`` (else the caller's error stands)."""
+        bas = self._kept_bas_before()
+        base = _BASE_MOTION.get(stmt.keyword)
+        ambiguous: dict[str, str] = getattr(self, "ambiguous", {})
+        from_bas = all(why.startswith("BAS(#") for why in ambiguous.values())
+        # nothing set since the BAS: a setting the program set in between is one the output
+        # would write only before a motion with settings, so this one would run without it
+        untouched = self.kept_bas is not None and self.kept_bas[0] is bas
+        untouched = untouched and self.kept_bas is not None and self.kept_bas[1] == self.state
+        expected = 2 if base == "CIRC" else 1
+        if bas is None or base is None or not (from_bas and untouched):
+            return False
+        if len(stmt.targets) != expected:
+            return False
+        if stmt.keyword.endswith("_REL") or stmt.with_clause or stmt.angle is not None:
+            return False
+        self.motion_count += 1
+        runtime = self._runtime_target(stmt)
+        why = f"its settings are what {bas.text} (line {bas.span.line}) sets at run time"
+        if stmt.approx:
+            self._note(
+                stmt.span,
+                f"{' '.join(stmt.approx)} after {bas.text}: the approximation distance is the "
+                "controller's, unknown to olp; written as an exact stop",
+            )
+        self.out.append(
+            ir.RuntimeMove(
+                motion=_RUNTIME_KINDS[base],
+                target=self._target_expr(stmt.targets[-1]),
+                via=self._target_expr(stmt.targets[0]) if base == "CIRC" else None,
+                reason=why if runtime is None else f"{runtime}; {why}",
+                controller_settings=True,
+                span=stmt.span,
+            )
+        )
+        self.track.lose(f"the {stmt.keyword} at line {stmt.span.line} runs with unknown settings")
+        return True
+
+    def _kept_bas_before(self) -> ir.Verbatim | None:
+        """The BAS kept as written (one given run-time values) that the next motion follows
+        in the same straight stretch, or None."""
+        for node in reversed(self.out):
+            if isinstance(node, (ir.Label, ir.RuntimeMove, *ir.BLOCK_TYPES)):
+                return None
+            if isinstance(node, ir.Verbatim) and node.reason.startswith("BAS #"):
+                return node
         return None
 
     def _keep_runtime_motion(self, stmt: MotionStmt, base: str, reason: str) -> None:
-        """Keep a motion to a run-time target as written (:class:`~olp.ir.Verbatim`, with a
-        warning): the KRL post writes it back, the controller computes the target; olp checks
-        nothing of it, and the next motion starts where olp does not know."""
+        """Keep a _REL motion by run-time offsets as written (:class:`~olp.ir.Verbatim`, with a
+        warning: :class:`~olp.ir.RuntimeMove` holds an absolute target): the KRL post writes it
+        back, the controller computes the target; olp checks nothing of it, and the next motion
+        starts where olp does not know."""
         self._settings_written_before(stmt, base, reason)
         self._keep(stmt, f"its target is known only when the program runs ({reason})")
         self._note(
@@ -238,6 +348,8 @@ class Motions(InlineForms):
         for node in reversed(self.out):
             if isinstance(node, (ir.Label, *ir.BLOCK_TYPES)):
                 return
+            if isinstance(node, ir.RuntimeMove) and node.controller_settings:
+                return  # the output writes every setting of the motion after one again
             if isinstance(node, ir.Verbatim) and node.reason.startswith("BAS #"):
                 raise self._error(
                     f"this motion follows {node.text} (line {node.span.line}), kept as written "
@@ -580,14 +692,20 @@ class Motions(InlineForms):
             raise self._error(str(exc), culprit.span) from None
 
     # ---- WITH
-    def _with_motion(self, stmt: MotionStmt, base: str, relative: bool) -> None:
+    def _with_motion(
+        self, stmt: MotionStmt, base: str, relative: bool, runtime: str | None = None
+    ) -> None:
         """WITH assignments hold for this motion only (olp's reading of the KSS manual,
-        unverified); the next motion without WITH gets a note saying so."""
+        unverified); the next motion without WITH gets a note saying so. ``runtime``: why the
+        target is known only at run time (then a :class:`~olp.ir.RuntimeMove`), or None."""
         saved = self.state
         for assignment in stmt.with_clause:
             self._with_assignment(assignment)
         during = self.state
-        self._plain_motion(stmt, base, relative)
+        if runtime is None:
+            self._plain_motion(stmt, base, relative)
+        else:
+            self._runtime_motion(stmt, base, runtime)
         self.state = saved
         if (during.tool, during.frame) != (saved.tool, saved.frame):
             line = stmt.span.line
@@ -616,6 +734,14 @@ def _offset(start: tuple[float, ...], delta: tuple[float, ...], option: str) -> 
         pose[:3, 3] = start_pose[:3, 3] + delta_pose[:3, 3]
     return tuple(float(v) for v in pose_to_frame(pose))
 
+
+_RUNTIME_KINDS: dict[str, Any] = {"PTP": "joint", "LIN": "linear", "CIRC": "circular"}
+
+CONFIG_DAT_POINTS = frozenset({"XHOME", *(f"XHOME{n}" for n in range(1, 7))})
+"""Points every KR C4 ``$config.dat`` declares (``E6AXIS XHOME``, ``XHOME1`` .. ``XHOME6``:
+found in all seven controller backups of benchmarks/krl_corpus.py that hold one; ``XHOME6``
+in one of them): without a ``$config.dat``, a motion to one is a motion to a run-time target
+whose value olp does not know, never a guess."""
 
 _MOTION_TEXT = re.compile(r"\s*(S?PTP|S?LIN|S?CIRC)(_REL)?\b", re.IGNORECASE)
 

@@ -54,9 +54,10 @@ def calls_in(nodes: Sequence[Any]) -> Iterator[PendingCall]:
 
 
 def moves(nodes: Sequence[Any]) -> bool:
-    """Whether ``nodes`` (or a routine they call) hold a motion."""
+    """Whether ``nodes`` (or a routine they call) hold a motion (one to a run-time target
+    too: it runs with the settings in effect where it runs)."""
     for node in leaves(nodes):
-        if ir.is_motion(node) or isinstance(node, ir.LinearPath):
+        if ir.is_motion(node) or isinstance(node, ir.LinearPath | ir.RuntimeMove):
             return True
         if isinstance(node, PendingCall) and moves(node.body):
             return True

@@ -232,6 +232,10 @@ SYSTEM_REASONS = {
 }
 
 
+CONFIG_DAT_DATA = frozenset({"FHOME", "PDEFAULT", "LDEFAULT"})
+"""Inline-form data every KR C4 ``$config.dat`` declares (``DECL FDAT FHOME``: all seven
+controller backups of benchmarks/krl_corpus.py that hold one; ``PDEFAULT``/``LDEFAULT``: the
+defaults the pendant's inline forms name)."""
 INLINE_FORM_DATA = frozenset({"PDAT_ACT", "LDAT_ACT", "FDAT_ACT"})
 """What the pendant's inline forms assign for BAS to read: absorbed into the motions' speeds,
 zones, tools and bases (:mod:`olp.frontends.krl.inline`), not kept as assignments."""
@@ -370,6 +374,8 @@ class Core:
         self._reported: set[tuple[Any, ...]] = set()
         self.motion_count = 0  # motions lowered so far (by this lowering)
         self.here_vars: dict[str, tuple[str, int]] = {}  # name -> ($POS_ACT..., motion_count)
+        # the last BAS kept as written (run-time values) and the motion settings when it ran
+        self.kept_bas: tuple[ir.Verbatim, State] | None = None
         self._setters: dict[str, Callable[[str, Expr, Stmt], None]] = {
             "$VEL.CP": self._set_vel_cp,
             "$ACC.CP": self._set_acc_cp,
@@ -507,10 +513,30 @@ class Core:
             else:
                 self.here_vars.pop(name, None)
             self.data.assign(stmt)  # what olp knows of the value afterwards
+            self._config_data_at_run_time(name, stmt)
             if name not in INLINE_FORM_DATA or self._runtime(self.variables.lookup(name)):
                 # PDAT_ACT = pdatNew with a run-time value: the BAS reading it is kept as
                 # written, so the assignment must reach the output too
                 self.out.append(self._assignment(stmt))
+
+    def _config_data_at_run_time(self, name: str, stmt: Assign) -> None:
+        """``FDAT_ACT = FHOME`` (``PDEFAULT``, ``LDEFAULT``: :data:`CONFIG_DAT_DATA`) without a
+        ``$config.dat``: the inline form's data is the cell's, which olp never guesses; it is
+        a value known only when the program runs, so the BAS that reads it is kept as written
+        and the motion right after it runs with the controller's settings
+        (:meth:`olp.frontends.krl.motion.Motions._controller_settings_motion`)."""
+        value = stmt.value
+        if name not in INLINE_FORM_DATA or self.ctx.config is not None:
+            return
+        if not isinstance(value, Var) or value.selectors:
+            return
+        known = self.variables.lookup(name)
+        if value.name.upper() in CONFIG_DAT_DATA and isinstance(known, Unknown) and known.missing:
+            reason = (
+                f"{name} = {value.name}: {value.name} is declared in the controller's "
+                "$config.dat, which was not given with --config-dat; olp does not guess its value"
+            )
+            self.variables.assign(name, Unknown(reason))
 
     def _set_vel_cp(self, name: str, value: Expr, stmt: Stmt) -> None:
         self._vel_cp(self._number(value, "$VEL.CP (m/s)"), value.span)

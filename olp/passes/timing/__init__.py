@@ -95,6 +95,10 @@ The model, point by point (each choice is what the estimate can be explained by)
   (:mod:`~olp.passes.timing.jerk`, which states what is exact and what is not). Measured: a
   rest-to-rest line matches Ruckig within 0.5%, ten 30 mm fine-stopped LINs at 250 mm/s the
   double S by hand within 0.5% (the acceleration-limited model was 35% short).
+* **Motions to run-time targets** (:class:`~olp.ir.RuntimeMove`) and the motion after one
+  (its start is unknown) are not timed: they take 0 s unless ``other_times`` names
+  ``runtime_move``, and the summary and report say that the cycle time is then a lower bound
+  (:func:`olp.report.untimed_motions`).
 * **Other instructions** take :data:`DEFAULT_TIMES` seconds (a ``Wait`` its own time); override
   any kind, or a named call as ``"call:NAME"``, through ``other_times``.
 

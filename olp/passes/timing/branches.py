@@ -340,10 +340,9 @@ class SegmentTimer:
         nodes: list[Any] = []
         firsts = []
         for run in runs:
-            joints = self._joints(run.entry)
             span = next(leaves(run.nodes)).span
             firsts.append(sum(_size((n,)) for n in nodes))
-            nodes += [ir.JointMove(target=ir.JointTarget(joints=joints), span=span), *run.nodes]
+            nodes += [self._lead_in(run.entry, span), *run.nodes]
         program = ir.Program(
             name="runs", instructions=tuple(nodes), source=self.compiled.program.source
         )
@@ -363,6 +362,16 @@ class SegmentTimer:
                 continue
             self.cache[(run.lo, run.hi, run.entry)] = float(totals[rows.stop] - totals[rows.start])
         return failed
+
+    def _lead_in(self, entry: int, span: SourceSpan) -> Any:
+        """What brings the robot to ``entry`` before a run (not counted): a joint move to its
+        joints, or the run-time motion itself (the run then starts where olp does not know,
+        as after it in the text)."""
+        if entry != START:
+            motion = self.compiled.steps[entry].instruction
+            if isinstance(motion, ir.RuntimeMove):
+                return motion
+        return ir.JointMove(target=ir.JointTarget(joints=self._joints(entry)), span=span)
 
     def _joints(self, entry: int) -> Any:
         joints = self.compiled.start_joints if entry == START else self.compiled.steps[entry].joints
@@ -390,14 +399,16 @@ def _size(nodes: Sequence[Any]) -> int:
 
 def motion_indices(program: ir.Program) -> NDArray[np.int64]:
     """The instruction indices of the motions of ``program``, ascending (a toolpath's rows
-    as one range, not one by one)."""
+    as one range, not one by one), motions to run-time targets included: the robot's position
+    after one is a position of the walk (olp does not know where; :meth:`SegmentTimer.time`
+    times what follows it as the text does, from an unknown start)."""
     parts, cursor = [], 0
     for node in leaves(program.instructions):
         if isinstance(node, ir.LinearPath):
             parts.append(np.arange(cursor, cursor + len(node)))
             cursor += len(node)
             continue
-        if ir.is_motion(node):
+        if ir.is_motion(node) or isinstance(node, ir.RuntimeMove):
             parts.append(np.array([cursor]))
         cursor += 1
     return np.concatenate(parts).astype(np.int64) if parts else np.zeros(0, dtype=np.int64)

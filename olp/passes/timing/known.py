@@ -293,6 +293,8 @@ def _statement_expressions(node: Any) -> list[Any]:
         return [node.condition]
     if isinstance(node, f.PathTrigger) and isinstance(node.action, f.Assign):
         return [node.action.target, node.action.value]
+    if isinstance(node, ir.RuntimeMove):  # its target may call a function (PTP fnGetPos())
+        return [node.target] if node.via is None else [node.via, node.target]
     return []
 
 
