@@ -14,10 +14,16 @@ next is read:
   window boundary: two consecutive colliding rows on either side are two diagnostics);
 * **timing**: :class:`~olp.passes.timing.window.WindowTimer` (a boundary inside a blended
   chain is timed with context on both sides, never as a stop);
-* **the post** checks the window and writes its rows
-  (:class:`~olp.posts.stream.StreamedRender`) into a staging folder beside the output folder
-  (:class:`~olp.output.StagedFolder`), which replaces the output folder only at the end, when
-  no error remains; on any error it is removed: never a half-written output.
+* **the post** applies its transforms to the window with the rows next to its boundaries
+  (:mod:`olp.posts.stream_transforms`: UR's blend capping; the next window is then read
+  before the window is given, to know which is the last), checks the window and writes its
+  rows (:class:`~olp.posts.stream.StreamedRender`) into a staging folder beside the output
+  folder (:class:`~olp.output.StagedFolder`), which replaces the output folder only at the
+  end, when no error remains; on any error it is removed: never a half-written output. A post
+  that renders each part whole (Fanuc: :attr:`~olp.posts.base.Post.STREAM_PARTS`) first counts
+  the parts in a pass that only reads the file. What the post says once per program (ABB's
+  tool load, Fanuc's frame and tool notes: ``ONCE_PER_PROGRAM``) is kept once; what it says
+  of the program's totals (UR's script length: ``TOTAL_KINDS``) is asked once at the end.
 
 Diagnostics keep their source line (the CSV row) and their instruction index in the whole
 program; instruction numbers in a message ("moves 12-14") are renumbered likewise. Per
