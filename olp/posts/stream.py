@@ -27,8 +27,9 @@ between two rows items and compute nothing else in a file from its rows (it says
 ``vendor`` context takes from its rows (ABB's speeddata and zonedata, declared before the
 rows in order of first use) comes from the few rows the post names for it
 (:meth:`~olp.posts.base.Post.context_rows`: the first row of each distinct speed and zone),
-kept per part while the rows stream past, and the context is computed from them when the
-file is rendered at the end. The post's ``TRANSFORMS`` are applied to each window by
+kept per part while the rows stream past; the context is computed from them when the
+part's rows are all written (they are then dropped) and given to the file's render at the
+end. The post's ``TRANSFORMS`` are applied to each window by
 :mod:`olp.posts.stream_transforms` (UR's blend capping, with the neighbour rows across a
 window boundary), where the post lists them (:attr:`~olp.posts.base.Post.WINDOW_TRANSFORMS`).
 ``tests/test_stream.py`` compares both builds. A template that writes a part's rows other
@@ -263,6 +264,7 @@ class _Part:
     calls: list[_Call] = field(default_factory=list)
     last: dict[str, Any] = field(default_factory=dict)
     context: list[SplicedRows] = field(default_factory=list)
+    vendor: Any = None
     rows: list[RowColumns] = field(default_factory=list)
 
 
@@ -361,7 +363,7 @@ class StreamedRender:
         for cut in self.counter.rows(len(block)):
             if cut > lo:
                 self._rows(BlockRows(block, lo, cut), motions)
-            _close(self.parts[-1])
+            self._settle(self.parts[-1])
             if self.planned is not None:
                 self._render_part(len(self.parts) - 1)
             self.parts.append(_Part())
@@ -508,7 +510,7 @@ class StreamedRender:
         for numbers that cannot be written (nothing is then to be committed)."""
         post = self.post
         for part in self.parts:
-            _close(part)
+            self._settle(part)
         if post.problems:
             raise RenderError(_unique(post.problems))
         if not self.rows_started:
@@ -545,6 +547,15 @@ class StreamedRender:
         if post.problems:
             raise RenderError(_unique(post.problems))
         return written
+
+    def _settle(self, part: _Part) -> None:
+        """A part whose rows are all written: its scratch files closed, and its ``vendor``
+        context computed from the rows kept for it (which are then dropped)."""
+        _close(part)
+        if part.context:
+            with_rows: list[Any] = [*part.steps, *part.context]
+            part.vendor = self.post.context_values(with_rows)
+            part.context = []
 
     def _unit_names(self, parts: int) -> list[str]:
         """The names of ``parts`` parts (none when the program is one file)."""
@@ -704,9 +715,8 @@ class StreamedRender:
             own = [c for c in part.calls if c.template == template]
             self.splicer.replaying, self.splicer.position = own, 0
             context = unit_context(self.post, self.station, unit, named.allocation, steps)
-            if part.context:
-                with_rows: list[Any] = [*part.steps, *part.context]
-                context["vendor"] = self.post.context_values(with_rows)
+            if part.vendor is not None:
+                context["vendor"] = part.vendor
             files = render_templates(self.post, self.env, [(template, pattern)], context, clash)
             ((fname, text),) = files.items()
             if self.splicer.position != len(own):
