@@ -10,10 +10,13 @@ window size a 1M build gets by itself), so that all sizes take the same path; th
 builds run as a user runs them (streamed from 1M rows where the post can stream). With
 ``--reference DIR`` (e.g. ``git archive main | tar -x -C DIR``) each per-post build also runs
 with that code, right before this code's, and the ratios this / reference are printed. A
-reference build that fails (out of memory) is reported as such.
+reference build that fails (out of memory) is reported as such. With ``--whole`` each per-post
+build also runs whole (``--chunk-rows 0``), right after, and the ratios streamed / whole are
+printed. ``--series-post`` names the post the series builds (default kuka).
 
     python benchmarks/scaling.py [--points 100000,1000000,10000000] [--posts kuka]
-                                 [--post-points 1000000] [--reference DIR]
+                                 [--post-points 1000000] [--reference DIR] [--whole]
+                                 [--series-post kuka]
 
 Last lines: ``name: value unit``.
 """
@@ -75,7 +78,10 @@ def main() -> None:
     parser.add_argument("--posts", default="kuka")
     parser.add_argument("--post-points", type=int, default=1_000_000)
     parser.add_argument("--reference", type=Path, default=None)
+    parser.add_argument("--whole", action="store_true")
+    parser.add_argument("--series-post", default="kuka")
     args = parser.parse_args()
+    series = args.series_post
     sizes = [int(p) for p in args.points.split(",") if p]
     results: list[tuple[str, float, str]] = []
     with tempfile.TemporaryDirectory() as scratch:
@@ -84,19 +90,19 @@ def main() -> None:
         for points in sizes:
             csv = folder / f"helix_{points}.csv"
             helix(points, csv)
-            done = build(csv, "kuka", folder / "out", WINDOW_ROWS)
+            done = build(csv, series, folder / "out", WINDOW_ROWS)
             csv.unlink()
+            tag = f"{series}_{label(points)}"
             if done is None:
-                results.append((f"kuka_{label(points)}_streamed_failed", 1.0, "x"))
+                results.append((f"{tag}_streamed_failed", 1.0, "x"))
                 continue
             walls[points] = done[0]
-            results.append((f"kuka_{label(points)}_streamed_seconds", done[0], "s"))
-            results.append((f"kuka_{label(points)}_streamed_peak_memory", done[1], "MB"))
-            results.append(
-                (f"kuka_{label(points)}_streamed_us_per_point", done[0] / points * 1e6, "us")
-            )
+            results.append((f"{tag}_streamed_seconds", done[0], "s"))
+            results.append((f"{tag}_streamed_peak_memory", done[1], "MB"))
+            results.append((f"{tag}_streamed_us_per_point", done[0] / points * 1e6, "us"))
         results += fit(walls)
-        results += per_post(folder, args.posts.split(","), args.post_points, args.reference)
+        posts = [p for p in args.posts.split(",") if p]
+        results += per_post(folder, posts, args.post_points, args.reference, args.whole)
     for name, value, unit in results:
         print(f"{name}: {value:.4g} {unit}")
 
@@ -121,9 +127,10 @@ def fit(walls: dict[int, float]) -> list[tuple[str, float, str]]:
 
 
 def per_post(
-    folder: Path, posts: list[str], points: int, reference: Path | None
+    folder: Path, posts: list[str], points: int, reference: Path | None, whole: bool = False
 ) -> list[tuple[str, float, str]]:
-    """Each post's build of ``points`` as a user runs it, and with the reference code."""
+    """Each post's build of ``points`` as a user runs it, with the reference code, and
+    (``whole``) built whole."""
     if points <= 0:
         return []
     csv = folder / "helix_post.csv"
@@ -148,7 +155,24 @@ def per_post(
         if ref is not None:
             out.append((f"{post}_{tag}_build_seconds_vs_reference", done[0] / ref[0], "x"))
             out.append((f"{post}_{tag}_peak_memory_vs_reference", done[1] / ref[1], "x"))
+        if whole:
+            out += whole_build(csv, post, folder / "whole", tag, done)
     return out
+
+
+def whole_build(
+    csv: Path, post: str, out: Path, tag: str, done: tuple[float, float]
+) -> list[tuple[str, float, str]]:
+    """The same build whole (``--chunk-rows 0``), and the build as run (``done``) against it."""
+    whole = build(csv, post, out, 0)
+    if whole is None:
+        return [(f"{post}_{tag}_whole_build_failed", 1.0, "x")]
+    return [
+        (f"{post}_{tag}_whole_build_seconds", whole[0], "s"),
+        (f"{post}_{tag}_whole_peak_memory", whole[1], "MB"),
+        (f"{post}_{tag}_build_seconds_vs_whole", done[0] / whole[0], "x"),
+        (f"{post}_{tag}_peak_memory_vs_whole", done[1] / whole[1], "x"),
+    ]
 
 
 if __name__ == "__main__":

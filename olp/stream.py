@@ -14,10 +14,16 @@ next is read:
   window boundary: two consecutive colliding rows on either side are two diagnostics);
 * **timing**: :class:`~olp.passes.timing.window.WindowTimer` (a boundary inside a blended
   chain is timed with context on both sides, never as a stop);
-* **the post** checks the window and writes its rows
-  (:class:`~olp.posts.stream.StreamedRender`) into a staging folder beside the output folder
-  (:class:`~olp.output.StagedFolder`), which replaces the output folder only at the end, when
-  no error remains; on any error it is removed: never a half-written output.
+* **the post** applies its transforms to the window with the rows next to its boundaries
+  (:mod:`olp.posts.stream_transforms`: UR's blend capping; the next window is then read
+  before the window is given, to know which is the last), checks the window and writes its
+  rows (:class:`~olp.posts.stream.StreamedRender`) into a staging folder beside the output
+  folder (:class:`~olp.output.StagedFolder`), which replaces the output folder only at the
+  end, when no error remains; on any error it is removed: never a half-written output. A post
+  that renders each part whole (Fanuc: :attr:`~olp.posts.base.Post.STREAM_PARTS`) first counts
+  the parts in a pass that only reads the file. What the post says once per program (ABB's
+  tool load, Fanuc's frame and tool notes: ``ONCE_PER_PROGRAM``) is kept once; what it says
+  of the program's totals (UR's script length: ``TOTAL_KINDS``) is asked once at the end.
 
 Diagnostics keep their source line (the CSV row) and their instruction index in the whole
 program; instruction numbers in a message ("moves 12-14") are renumbered likewise. Per
@@ -230,7 +236,12 @@ def build_streamed(
             program_name = name or windows.name
             from olp.posts.stream import StreamedRender
 
-            writer = StreamedRender(post, staged, station, program_name, str(path))
+            planned = None
+            if post.STREAM_PARTS:
+                clock.start()
+                planned = _planned_parts(path, program_options, station, rows, post)
+                clock.stop("read")
+            writer = StreamedRender(post, staged, station, program_name, str(path), planned)
             run = _Run(station, options, post, writer, findings, totals, clock)
             estimate = count_lines(path) - windows.layout.header_rows
             with progress.stage("build", estimate, "rows"):
@@ -262,6 +273,17 @@ def build_streamed(
     return BuildResult(compiled, post.name, diagnostics, {}, written, streamed=summary)
 
 
+def _planned_parts(
+    path: Path, options: CsvOptions | None, station: Station, rows: int, post: Post
+) -> int:
+    """The parts the program will be split into (a first pass that reads the file only)."""
+    from olp.frontends.csv import CsvWindows
+    from olp.posts.stream import count_parts
+
+    with CsvWindows(path, options, station, rows) as windows, progress.showing(None):
+        return count_parts(windows, post.manifest.limits)
+
+
 class _Run:
     """The windows through the pipeline, one after the other."""
 
@@ -283,12 +305,14 @@ class _Run:
         self.start = station.robot.home.copy()
         self.offset = 0
         self.offsets: list[int] = []
+        self.once: set[tuple[str, str]] = set()
         limits = station.robot.limits
         self.timer = WindowTimer(options.other_times, options.timing, limits.path_acceleration)
+        self.transforms = [make(post) for make in post.WINDOW_TRANSFORMS or ()]
 
     def all(self, windows: Iterable[Program]) -> None:
-        for window in _quietly(windows, self.clock):
-            self.clock.stop("read")
+        peek = bool(self.transforms)  # they need to know which window is the last
+        for window, is_last in _quietly(windows, self.clock, peek):
             checked = self.check(window)
             self.offsets.append(self.offset)
             size = len(checked.steps)
@@ -297,7 +321,7 @@ class _Run:
                 timed = self.timer.push(checked)
                 self.clock.stop("time")
                 if timed is not None:
-                    self.emit(timed, self.offsets[-2])
+                    self.emit(timed, self.offsets[-2], checked, is_last)
             self.offset += size
             progress.advance(size)
             self.clock.start()
@@ -307,6 +331,7 @@ class _Run:
             self.clock.stop("time")
             if last is not None:
                 self.emit(last, self.offsets[-1])
+            self.findings.add(self.post.check_totals(self.totals.resolved))
 
     def check(self, window: Program) -> CompiledProgram:
         """Resolve, flow and collision passes on one window, from the previous one's joints."""
@@ -331,13 +356,23 @@ class _Run:
         self.start = _last_joints(compiled, self.start)
         return dataclasses.replace(compiled, diagnostics=())
 
-    def emit(self, timed: CompiledProgram, offset: int) -> None:
-        """A timed window: its timing findings, the post's checks, its rows written."""
+    def emit(
+        self,
+        timed: CompiledProgram,
+        offset: int,
+        following: CompiledProgram | None = None,
+        last: bool = True,
+    ) -> None:
+        """A timed window: its timing findings, the post's transforms (``following``: the
+        next window, checked; ``last``: it is the last) and checks, its rows written."""
         from olp.posts.stream import StreamedRender
 
         self.findings.add(timed.diagnostics, offset)
         self.clock.start()
-        found = self.post.check(timed)
+        for transform in self.transforms:
+            timed, found = transform.apply(timed, following, last)
+            self.findings.add(found, offset)
+        found = self.program_once(self.post.check(timed))
         self.findings.add(found, offset)
         self.clock.stop("check")
         if self.findings.errors:
@@ -348,18 +383,46 @@ class _Run:
             self.writer.add(timed, offset)
         self.clock.stop("write")
 
+    def program_once(self, found: list[Diagnostic]) -> list[Diagnostic]:
+        """A window's post diagnostics without those the post gives once per program and an
+        earlier window gave, nor those it gives from the program's totals
+        (:attr:`~olp.posts.base.Post.ONCE_PER_PROGRAM`, ``TOTAL_KINDS``)."""
+        once, totals = self.post.ONCE_PER_PROGRAM, self.post.TOTAL_KINDS
+        out = []
+        for diag in found:
+            key = (diag.kind, diag.message)
+            if diag.kind in totals or (diag.kind in once and key in self.once):
+                continue
+            if diag.kind in once:
+                self.once.add(key)
+            out.append(diag)
+        return out
 
-def _quietly(windows: Iterable[Program], clock: _Clock) -> Iterator[Program]:
-    """The windows, each read without progress of its own (the build's stage counts rows)."""
+
+def _quietly(
+    windows: Iterable[Program], clock: _Clock, peek: bool
+) -> Iterator[tuple[Program, bool]]:
+    """The windows, each read without progress of its own (the build's stage counts rows),
+    and whether it is the last; ``peek``: the next window is read before one is given (else
+    every window is given as not the last)."""
     it = iter(windows)
-    while True:
-        clock.start()
-        with progress.showing(None):
-            window = next(it, None)
-        if window is None:
-            clock.stop("read")
-            return
-        yield window
+    window = _read(it, clock)
+    while window is not None:
+        if not peek:
+            yield window, False
+            window = _read(it, clock)
+            continue
+        following = _read(it, clock)
+        yield window, following is None
+        window = following
+
+
+def _read(it: Iterator[Program], clock: _Clock) -> Program | None:
+    clock.start()
+    with progress.showing(None):
+        window = next(it, None)
+    clock.stop("read")
+    return window
 
 
 def _last_joints(compiled: CompiledProgram, before: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import filecmp
 import os
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -33,12 +34,19 @@ def station() -> olp.Station:
     return olp.load_station(CELL)
 
 
-def helix_csv(path: Path, points: int, speeds: bool = True, turns: float = 2.0) -> Path:
-    """A helix in the table frame (mm), with a speed column that changes every 1,500 rows."""
+def helix_csv(
+    path: Path,
+    points: int,
+    speeds: bool = True,
+    turns: float = 2.0,
+    pair: tuple[float, float] = (50.0, 80.0),
+) -> Path:
+    """A helix in the table frame (mm), with a speed column that changes every 1,500 rows
+    between the two speeds of ``pair`` (mm/s)."""
     t = np.linspace(0.0, 2.0 * np.pi * turns, points)
     xyz = np.c_[100 + 60 * np.cos(t), 60 * np.sin(t), 20 + np.linspace(0.0, 30.0, points)]
     if speeds:
-        speed = np.where((np.arange(points) // 1500) % 2 == 0, 50.0, 80.0)
+        speed = np.where((np.arange(points) // 1500) % 2 == 0, *pair)
         np.savetxt(path, np.c_[xyz, speed], fmt="%.4f", delimiter=",", header="x,y,z,speed")
     else:
         np.savetxt(path, xyz, fmt="%.4f", delimiter=",", header="x,y,z")
@@ -118,6 +126,91 @@ def test_with_the_jerk_layer_a_blended_toolpath_stays_within_half_a_percent(
     assert streamed.streamed.cycle_time == pytest.approx(whole.compiled.cycle_time, rel=5e-3)
 
 
+def diagnostics(result: olp.BuildResult) -> list[str]:
+    return sorted(d.format() for d in result.diagnostics)
+
+
+def test_streamed_rapid_is_byte_identical_with_each_parts_speed_and_zone_data(
+    station: olp.Station, tmp_path: Path
+) -> None:
+    """Custom speeddata and zonedata (not predefined: v57_5, z0_7) are declared per module
+    in order of first use, before its rows; a part that starts inside one speed's run and
+    meets the other in a later window declares both, as the whole build does. (Parts of
+    2,000 motions, to keep the blended build small.)"""
+    csv = helix_csv(tmp_path / "helix.csv", 5_000, pair=(57.5, 83.25))
+    post = copied_post(tmp_path, "abb", "max_motions_per_file: 5000", "max_motions_per_file: 2000")
+    whole, streamed = both(station, csv, tmp_path, post, zone=0.7, window=1_000)
+    assert whole.ok and streamed.ok
+    same_files(tmp_path / "whole", tmp_path / "windows")
+    part = (tmp_path / "windows" / "helix_P2.mod").read_text()
+    assert "speeddata v83_25 :=" in part and "speeddata v57_5 :=" in part
+    assert "zonedata z0_7 :=" in part
+    assert diagnostics(streamed) == diagnostics(whole)  # tool_load once per tool
+
+
+def test_streamed_urscript_caps_blends_across_window_boundaries(
+    station: olp.Station, tmp_path: Path
+) -> None:
+    """Every blend of the helix is capped to half the distance to its neighbours; at a
+    window boundary the neighbour is in the next window (a window capped alone would stop
+    there: r=0), and the program's last move stops."""
+    csv = helix_csv(tmp_path / "helix.csv", 4_000)
+    whole, streamed = both(station, csv, tmp_path, "ur", zone=0.7, window=1_000)
+    assert whole.ok and streamed.ok
+    names = sorted(p.name for p in (tmp_path / "whole").iterdir())
+    assert names == sorted(p.name for p in (tmp_path / "windows").iterdir())
+    for name in names:
+        assert (tmp_path / "whole" / name).read_bytes() == (
+            tmp_path / "windows" / name
+        ).read_bytes()
+    capped = [d.format() for d in streamed.diagnostics if d.kind == "blend_capped"]
+    assert len(capped) >= 900  # the first MAX_DIAGNOSTICS warnings are kept
+    assert (
+        capped == [d.format() for d in whole.diagnostics if d.kind == "blend_capped"][: len(capped)]
+    )
+    too_long = [d.message for d in streamed.diagnostics if d.kind == "program_too_long"]
+    assert too_long == [] or too_long[0].startswith("4000 motions")
+
+
+def test_streamed_urscript_without_blends_has_the_same_diagnostics(
+    station: olp.Station, tmp_path: Path
+) -> None:
+    """``program_too_long`` counts the whole program's motions, once."""
+    csv = helix_csv(tmp_path / "helix.csv", 6_000)
+    whole, streamed = both(station, csv, tmp_path, "ur")
+    assert (tmp_path / "whole" / "helix.script").read_bytes() == (
+        tmp_path / "windows" / "helix.script"
+    ).read_bytes()
+    assert diagnostics(streamed) == diagnostics(whole)
+    assert [d.message[:13] for d in streamed.diagnostics if d.kind == "program_too_long"] == [
+        "6000 motions "
+    ]
+
+
+def test_streamed_ls_renders_each_part_whole(station: olp.Station, tmp_path: Path) -> None:
+    """Fanuc parts (3,000 instructions) are numbered P[1].. each, their /MN lines numbered
+    and counted (LINE_COUNT) over the part's whole text: each part is rendered whole from
+    its rows, the number of parts (and so their names) counted before."""
+    csv = helix_csv(tmp_path / "helix.csv", 12_000)
+    whole, streamed = both(station, csv, tmp_path, "fanuc")
+    assert whole.ok and streamed.ok
+    same_files(tmp_path / "whole", tmp_path / "windows")
+    assert sorted(p.name for p in (tmp_path / "windows").iterdir())[-1] == "HELIX_P4.ls"
+    assert diagnostics(streamed) == diagnostics(whole)  # the UFRAME/UTOOL notes once
+
+
+def copied_post(tmp_path: Path, name: str, old: str, new: str) -> object:
+    """The bundled post ``name`` from a copy of its folder whose post.yaml says ``new``
+    instead of ``old``."""
+    folder = tmp_path / f"{name}_copy"
+    shutil.copytree(ROOT / "posts" / name, folder)
+    manifest = folder / "post.yaml"
+    text = manifest.read_text()
+    assert old in text
+    manifest.write_text(text.replace(old, new))
+    return find_post(str(folder))
+
+
 def test_an_error_in_a_late_window_writes_nothing(station: olp.Station, tmp_path: Path) -> None:
     csv = helix_csv(tmp_path / "helix.csv", 9_000)
     lines = csv.read_text().splitlines()
@@ -150,7 +243,10 @@ def test_window_rows_decides_when_to_stream(
     assert window_rows(csv, kuka, build, None) is None  # small: whole
     assert window_rows(csv, kuka, build, 500) == 500
     assert window_rows(csv, kuka, build, 0) is None
-    assert window_rows(csv, abb, build, 500) is None  # per-file speed data from the rows
+    assert window_rows(csv, abb, build, 500) == 500  # per-file speed data: kept per part
+    limit = "max_instructions_per_file: 3000"
+    lined = copied_post(tmp_path, "fanuc", limit, limit + "\n  max_lines_per_file: 9999")
+    assert window_rows(csv, lined, build, 500) is None  # the whole text's lines counted
     monkeypatch.setattr(olp.stream, "STREAM_ROWS", 2_000)
     assert window_rows(csv, kuka, build, None) == olp.stream.WINDOW_ROWS
     result = olp.build(station, csv, "kuka", tmp_path / "out", program_options=options())

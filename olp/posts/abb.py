@@ -546,6 +546,9 @@ class AbbPost(Post):
     WRITES_FLOW = True
     WRITES_ROUTINES = True
     KINDS: ClassVar[frozenset[str]] = Post.KINDS | {"runtime_move"}
+    STREAMS = True
+    STREAM_NEUTRAL_FILTERS = frozenset({"rapid_pad"})
+    ONCE_PER_PROGRAM = frozenset({"tool_load"})
 
     def __init__(self, manifest: Any) -> None:
         super().__init__(manifest)
@@ -596,6 +599,14 @@ class AbbPost(Post):
             "routine_data": flow.declarations(exported=False, skip=own),
             "module_data": flow.declarations(exported=True),
         }
+
+    def context_rows(self, rows: RowColumns) -> Sequence[int]:
+        """The first row of each distinct speed and of each distinct zone of ``rows``: all
+        :meth:`context_values` takes of rows is their data in order of first use."""
+        first_speeds = np.unique(rows.speeds, return_index=True)[1]
+        first_zones = np.unique(rows.zones, return_index=True)[1]
+        keep: list[int] = np.union1d(first_speeds, first_zones).tolist()
+        return keep
 
     def _motion_data(self, step: PostStep, speeds: dict[str, str], zones: dict[str, str]) -> None:
         """The custom speeddata and zonedata of one motion, added where new."""

@@ -70,6 +70,7 @@ if TYPE_CHECKING:
     from olp.compiled import CompiledProgram, PathBlock, Step
     from olp.posts.manifest import PostManifest
     from olp.posts.rows import PostRows
+    from olp.posts.stream_transforms import WindowTransform
     from olp.posts.view import PostStep, RowColumns
 
 FloatArray = NDArray[np.float64]
@@ -190,7 +191,29 @@ class Post:
     STREAMS: ClassVar[bool] = False
     """Whether a big toolpath may be written window by window (:mod:`olp.posts.stream`): the
     templates write each rows item only through row writer filters applied to the item itself,
-    nothing between two rows items, and nothing else in a file is computed from its rows."""
+    nothing between two rows items, and nothing else in a file is computed from its rows but
+    what :meth:`context_rows` keeps for :meth:`context_values`."""
+    WINDOW_TRANSFORMS: ClassVar[tuple[type[WindowTransform], ...] | None] = None
+    """The ``TRANSFORMS`` as a streamed build applies them, window by window, to a program
+    without control flow (:mod:`olp.posts.stream_transforms`); None where they cannot be (a
+    post with ``TRANSFORMS`` then builds whole)."""
+    ONCE_PER_PROGRAM: ClassVar[frozenset[str]] = frozenset()
+    """Diagnostic kinds :meth:`check_program` gives at most once per message in a program
+    (ABB's ``tool_load``: once per tool): a streamed build, checked window by window, keeps
+    the first."""
+    TOTAL_KINDS: ClassVar[frozenset[str]] = frozenset()
+    """Diagnostic kinds :meth:`check_program` gives from the whole program's totals (UR's
+    ``program_too_long``): a streamed build drops them from its windows' checks and asks
+    :meth:`check_totals` once at the end."""
+    STREAM_PARTS: ClassVar[bool] = False
+    """Whether a streamed build renders each part's templates whole, from the part's rows
+    kept in memory (bounded by the manifest's ``limits``; the number of parts is counted
+    first), rather than splicing the row writers' text into the file: for templates that
+    compute a file's text from all its rows (Fanuc's line numbers, ``LINE_COUNT``)."""
+    STREAM_NEUTRAL_FILTERS: ClassVar[frozenset[str]] = frozenset()
+    """Filters a template may apply to a rows item that read nothing of its rows (ABB's and
+    UR's indentation inside blocks): a streamed build runs them on the rows' stand-in instead
+    of taking them for a row writer."""
 
     def __init__(self, manifest: PostManifest) -> None:
         self.manifest = manifest
@@ -227,12 +250,24 @@ class Post:
         """Per file: the ``vendor`` context entry (e.g. ABB's custom speed data)."""
         return {}
 
+    def context_rows(self, rows: RowColumns) -> Sequence[int]:
+        """The rows (positions in ``rows``, ascending) of a toolpath's rows whose values
+        :meth:`context_values` needs: a streamed build (:mod:`olp.posts.stream`) keeps only
+        these of a file's rows for it, and gets the same ``vendor`` entry as from all of them.
+        None by default (:meth:`context_values` reads no row)."""
+        return ()
+
     def check_instruction(self, step: Step, compiled: CompiledProgram) -> list[Diagnostic]:
         """What this language cannot say exactly about one instruction."""
         return []
 
     def check_program(self, compiled: CompiledProgram) -> list[Diagnostic]:
         """What this language cannot say exactly about the whole program."""
+        return []
+
+    def check_totals(self, motions: int) -> list[Diagnostic]:
+        """The :attr:`TOTAL_KINDS` diagnostics of a program of ``motions`` written motions
+        (none by default)."""
         return []
 
     def reserved_names(self, compiled: CompiledProgram) -> Sequence[str]:

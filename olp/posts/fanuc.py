@@ -609,6 +609,9 @@ class FanucPost(Post):
     ROWS = True
     COLUMNS = True
     WRITES_FLOW = True
+    STREAMS = True
+    STREAM_PARTS = True
+    ONCE_PER_PROGRAM = frozenset({"controller_frame", "controller_tool"})
     NAME_RULE = NAME_RULE
     COMMENTS = CommentRule(max_length=COMMENT_LENGTH, replace=((";", ","),), collapse=True)
     IO_RANGE = (1, 4096)

@@ -21,13 +21,32 @@ that stand-in (the post's row writers: ``krl_rows``, ``krl_rows_dat``, ...) is i
 
 The text is the one :func:`olp.posts.render.render` writes, byte for byte, for a post whose
 templates write a run of toolpath rows as the row writer's output per rows item and nothing
-between two rows items and computes nothing else in a file from its rows (it says so:
-:attr:`~olp.posts.base.Post.STREAMS`; KUKA's do), whose ``vendor`` context does not depend on
-the rows (:meth:`~olp.posts.base.Post.context_values` not overridden), without ``TRANSFORMS``
-(they may look across a window boundary) and without a ``max_lines_per_file`` limit (it needs
-the whole text): :func:`streams`. ``tests/test_stream.py`` compares both builds. A template
-that writes a part's rows other than through a filter applied to its rows item is a
-PostError, not a file with one row.
+between two rows items and compute nothing else in a file from its rows (it says so:
+:attr:`~olp.posts.base.Post.STREAMS`; KUKA's, ABB's and UR's do), and without a
+``max_lines_per_file`` limit (it needs the whole text): :func:`streams`. What a file's
+``vendor`` context takes from its rows (ABB's speeddata and zonedata, declared before the
+rows in order of first use) comes from the few rows the post names for it
+(:meth:`~olp.posts.base.Post.context_rows`: the first row of each distinct speed and zone),
+kept per part while the rows stream past; the context is computed from them when the
+part's rows are all written (they are then dropped) and given to the file's render at the
+end. The post's ``TRANSFORMS`` are applied to each window by
+:mod:`olp.posts.stream_transforms` (UR's blend capping, with the neighbour rows across a
+window boundary), where the post lists them (:attr:`~olp.posts.base.Post.WINDOW_TRANSFORMS`).
+``tests/test_stream.py`` compares both builds. A template that writes a part's rows other
+than through a filter applied to its rows item is a PostError, not a file with one row; a
+filter that reads nothing of a rows item (ABB's and UR's indentation inside blocks) says so
+(:attr:`~olp.posts.base.Post.STREAM_NEUTRAL_FILTERS`) and runs on the stand-in.
+
+Posts whose templates compute a file's text from all of its rows (Fanuc: ``ls_moves`` over
+the file's steps numbers its positions, ``ls_number_lines`` numbers the ``/MN`` lines and
+``LINE_COUNT`` counts them) render each part whole instead
+(:attr:`~olp.posts.base.Post.STREAM_PARTS`): their manifest bounds a part's instructions
+(Fanuc: 3,000), so a part's rows are kept (copied out of their windows) until it is
+complete, and it is then rendered as the whole build renders it. A part's text holds its
+name, which depends on the number of parts (``_P1`` or ``_P01``), so that number is
+counted first, by a pass that only reads the file (:func:`count_parts`); a program that
+comes out in another number of parts is a PostError. A ``max_lines_per_file`` limit is
+still checked on the whole text only: such a post builds whole.
 
 Names: point names of toolpath rows follow the post's ``point_names`` pattern without being
 kept in memory; the few names taken besides them (the program's, its parts', tools, frames,
@@ -41,17 +60,17 @@ from __future__ import annotations
 import dataclasses
 import re
 import shutil
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, BinaryIO
+from typing import TYPE_CHECKING, Any, BinaryIO, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
 
 from olp.compiled import BlockRows, CompiledProgram, PathBlock, Step, items_of
 from olp.errors import PostError
-from olp.ir import Program, is_motion
+from olp.ir import LinearPath, Program, is_motion
 from olp.posts.base import Post, _bind
 from olp.posts.render import (
     RenderError,
@@ -91,11 +110,31 @@ def streams(post: Post) -> bool:
         post.STREAMS
         and post.COLUMNS
         and post.rows_enabled()
-        and not post.TRANSFORMS
-        and type(post).context_values is Post.context_values
+        and (not post.TRANSFORMS or post.WINDOW_TRANSFORMS is not None)
         and manifest.limits.max_lines is None
+        and (not post.STREAM_PARTS or planned_parts(manifest.limits))
         and _point_pattern(post) is not None
     )
+
+
+def planned_parts(limits: SplitLimits) -> bool:
+    """Whether ``limits`` bound the instructions of a part (so that a part's rows may be
+    kept to render it whole: :attr:`~olp.posts.base.Post.STREAM_PARTS`)."""
+    return limits.max_motions is not None or limits.max_instructions is not None
+
+
+def count_parts(programs: Iterable[Program], limits: SplitLimits) -> int:
+    """The parts a program read in windows (``programs``) is split into by ``limits``, every
+    instruction written (as the streamed build counts them: :class:`PartCounter`)."""
+    counter, parts = PartCounter(limits), 1
+    for program in programs:
+        node: Any
+        for node in program.instructions:
+            if isinstance(node, LinearPath):
+                parts += len(counter.rows(len(node)))
+            else:
+                parts += int(counter.step(is_motion(node), True))
+    return parts
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -158,11 +197,15 @@ def _splicing_environment(post: Post, splicer: _Splicer) -> PostSandbox:
         filter_.__name__ = getattr(fn, "__name__", "filter")
         return filter_
 
-    filters = {name: wrap(_bind(fn, post)) for name, fn in post.FILTERS.items()}
+    neutral = post.STREAM_NEUTRAL_FILTERS
+    filters = {
+        name: _bind(fn, post) if name in neutral else wrap(_bind(fn, post))
+        for name, fn in post.FILTERS.items()
+    }
     return make_environment(post.manifest.folder, filters)
 
 
-class _Parts:
+class PartCounter:
     """Where a split begins, counted as :func:`olp.transforms.split.split_bounds` counts, one
     instruction or one run of rows at a time."""
 
@@ -220,6 +263,9 @@ class _Part:
     placeholder: SplicedRows | None = None
     calls: list[_Call] = field(default_factory=list)
     last: dict[str, Any] = field(default_factory=dict)
+    context: list[SplicedRows] = field(default_factory=list)
+    vendor: Any = None
+    rows: list[RowColumns] = field(default_factory=list)
 
 
 @dataclass(slots=True)
@@ -245,8 +291,13 @@ class StreamedRender:
         station: Station,
         name: str,
         source: str,
+        planned: int | None = None,
     ) -> None:
         self.post = post
+        self.planned = planned
+        """Parts the program will have, where the post renders each part whole
+        (:attr:`~olp.posts.base.Post.STREAM_PARTS`; None: it splices rows)."""
+        self.done: list[str] = []
         self.manifest = post.manifest
         self.staged = staged
         self.station = station
@@ -258,7 +309,7 @@ class StreamedRender:
         self.pattern = pattern
         self.splicer = _Splicer(staged.scratch)
         self.env = _splicing_environment(post, self.splicer)
-        self.counter = _Parts(self.manifest.limits)
+        self.counter = PartCounter(self.manifest.limits)
         self.parts: list[_Part] = [_Part()]
         self.head: list[Step] = []
         self.head_program: CompiledProgram | None = None
@@ -312,7 +363,9 @@ class StreamedRender:
         for cut in self.counter.rows(len(block)):
             if cut > lo:
                 self._rows(BlockRows(block, lo, cut), motions)
-            _close(self.parts[-1])
+            self._settle(self.parts[-1])
+            if self.planned is not None:
+                self._render_part(len(self.parts) - 1)
             self.parts.append(_Part())
             lo = cut
         self._rows(BlockRows(block, lo, len(block)), motions)
@@ -324,7 +377,7 @@ class StreamedRender:
         program = self.head_program or window
         self.view = ProgramView(dataclasses.replace(program, steps=tuple(self.head)), self.post)
         self.number = len(self.view.motions)
-        self.named = self._names([], [self.number + 1])
+        self.named = self._names(self._unit_names(self.planned or 0), [self.number + 1])
         part = self.parts[0]
         for step in self.head:
             view_step = self._head_step(step, self.named.allocation, part.last)
@@ -350,9 +403,15 @@ class StreamedRender:
     def _rows(self, piece: BlockRows, motions: BlockMotions) -> None:
         part = self.parts[-1]
         rows = self._columns(piece, motions, part.last)
+        if self.planned is not None:
+            if part.placeholder is None:
+                part.placeholder = _stand_in(rows)
+            part.rows.append(_owned(rows, 0, len(rows), RowColumns))
+            return
         if part.placeholder is None:
             part.placeholder = _stand_in(rows)
             part.calls = self._record(part)
+        part.context += [_stand_in(rows, k) for k in self.post.context_rows(rows)]
         for call in part.calls:
             self._write(call, call.fn(rows, *call.args, **call.kwargs))
 
@@ -451,24 +510,34 @@ class StreamedRender:
         for numbers that cannot be written (nothing is then to be committed)."""
         post = self.post
         for part in self.parts:
-            _close(part)
+            self._settle(part)
         if post.problems:
             raise RenderError(_unique(post.problems))
         if not self.rows_started:
             self._begin_without_rows()
         count = len(self.parts) if len(self.parts) > 1 else 0
-        unit_names = (
-            part_names(self.name, count, post.NAME_RULE.legal, post.NAME_RULE.max_length)
-            if count
-            else []
-        )
+        unit_names = self._unit_names(len(self.parts))
         named = self._names(unit_names, self.firsts)
         self._check_names(named, unit_names)
+        if self.planned is not None:
+            if len(self.parts) != self.planned:
+                raise PostError(
+                    f"a streamed program came out in {len(self.parts)} parts, not the "
+                    f"{self.planned} planned: build it whole (olp build --chunk-rows 0)"
+                )
+            self._render_part(len(self.parts) - 1)
         written: list[str] = []
         main_files: set[str] = set()
         if count:
             main_files = set(self._main(named, unit_names))
             written += sorted(main_files)
+        if self.planned is not None:
+            if main_files & set(self.done):
+                raise PostError(f"post {self.manifest.name!r} writes a file twice")
+            post.collecting = False
+            if post.problems:
+                raise RenderError(_unique(post.problems))
+            return written + self.done
         for k, part in enumerate(self.parts):
             index = k + 1 if count else 0
             unit_name = unit_names[k] if count else self.name
@@ -479,13 +548,51 @@ class StreamedRender:
             raise RenderError(_unique(post.problems))
         return written
 
+    def _settle(self, part: _Part) -> None:
+        """A part whose rows are all written: its scratch files closed, and its ``vendor``
+        context computed from the rows kept for it (which are then dropped)."""
+        _close(part)
+        if part.context:
+            with_rows: list[Any] = [*part.steps, *part.context]
+            part.vendor = self.post.context_values(with_rows)
+            part.context = []
+
+    def _unit_names(self, parts: int) -> list[str]:
+        """The names of ``parts`` parts (none when the program is one file)."""
+        if parts <= 1:
+            return []
+        rule = self.post.NAME_RULE
+        return part_names(self.name, parts, rule.legal, rule.max_length)
+
+    def _render_part(self, k: int) -> None:
+        """Where the post renders each part whole (:attr:`planned`): part ``k``'s files, from
+        its steps and its rows, kept for it alone, into the staged folder."""
+        assert self.named is not None and self.planned is not None
+        if k >= self.planned:
+            raise PostError(
+                f"a streamed program came out in more parts than the {self.planned} planned: "
+                "build it whole (olp build --chunk-rows 0)"
+            )
+        part, named = self.parts[k], self.named
+        count = self.planned if self.planned > 1 else 0
+        unit_names = self._unit_names(self.planned)
+        name, routine = (unit_names[k], named.routines[k]) if count else (self.name, named.entry)
+        unit = Unit(name, self.name, self.source, k + 1 if count else 0, count, routine)
+        steps: list[Any] = [*part.steps, *part.rows]
+        context = unit_context(self.post, self.station, unit, named.allocation, steps)
+        files = render_templates(self.post, self.env, self.manifest.files, context, set(self.done))
+        for fname, text in files.items():
+            self.staged.add(fname, self._encode(text, fname))
+            self.done.append(fname)
+        part.rows = []
+
     def _begin_without_rows(self) -> None:
         """A program of ordinary instructions only (a one-row toolpath)."""
         self.rows_started = True
         program = self.head_program
         assert program is not None
         self.view = ProgramView(dataclasses.replace(program, steps=tuple(self.head)), self.post)
-        self.named = self._names([], [])
+        self.named = self._names(self._unit_names(self.planned or 0), [])
         part = self.parts[0]
         for step in self.head:
             view_step = self._head_step(step, self.named.allocation, part.last)
@@ -608,6 +715,8 @@ class StreamedRender:
             own = [c for c in part.calls if c.template == template]
             self.splicer.replaying, self.splicer.position = own, 0
             context = unit_context(self.post, self.station, unit, named.allocation, steps)
+            if part.vendor is not None:
+                context["vendor"] = part.vendor
             files = render_templates(self.post, self.env, [(template, pattern)], context, clash)
             ((fname, text),) = files.items()
             if self.splicer.position != len(own):
@@ -640,13 +749,22 @@ def _close(part: _Part) -> None:
             call.handle = None
 
 
-def _stand_in(rows: RowColumns) -> SplicedRows:
-    """The stand-in of a file's rows: ``rows``' first row, its arrays copied (a part's
+_R = TypeVar("_R", bound=RowColumns)
+
+
+def _stand_in(rows: RowColumns, row: int = 0) -> SplicedRows:
+    """The stand-in of a file's rows: row ``row`` of ``rows``, its arrays copied (a part's
     stand-in lives to the end of the build; it must not keep a whole block alive)."""
+    return _owned(rows, row, row + 1, SplicedRows)
+
+
+def _owned(rows: RowColumns, lo: int, hi: int, kind: type[_R]) -> _R:
+    """Rows ``lo`` to ``hi`` of ``rows`` as a ``kind`` of their own, their arrays copied (so
+    that they do not keep their window's block alive)."""
     piece, motions = rows.piece, rows.motions
-    block, k = piece.block, piece.lo
+    block, k, n = piece.block, piece.lo + lo, hi - lo
     assert block.joints is not None and block.path is not None and block.ends is not None
-    node = block.node.rows(k, k + 1)
+    node = block.node.rows(k, k + n)
 
     def own(values: Any) -> Any:
         return None if values is None else np.array(values)
@@ -660,27 +778,27 @@ def _stand_in(rows: RowColumns) -> SplicedRows:
         widths=own(node.widths),
         labels=own(node.labels),
     )
-    lo = 0 if k == 0 else int(block.ends[k - 1])
+    first = 0 if k == 0 else int(block.ends[k - 1])
     small = PathBlock(
         block.start + k,
         node,
         block.tool,
         block.frame,
-        np.array(block.joints[k : k + 1]),
-        np.array(block.path[lo : int(block.ends[k]) + 1]),
-        np.array([int(block.ends[k]) - lo]),
+        np.array(block.joints[k : k + n]),
+        np.array(block.path[first : int(block.ends[k + n - 1]) + 1]),
+        np.array(block.ends[k : k + n]) - first,
     )
-    columns = {key: np.array(value[k : k + 1]) for key, value in motions.columns.items()}
-    return SplicedRows(
-        BlockRows(small, 0, 1),
+    columns = {key: np.array(value[k : k + n]) for key, value in motions.columns.items()}
+    return kind(
+        BlockRows(small, 0, n),
         BlockMotions(small, motions.number + k, motions.frame_pose, columns),
-        [str(rows.names[0])],
+        [str(name) for name in rows.names[lo:hi]],
         rows.tool_item,
         rows.frame_item,
-        rows.new_tool,
-        rows.new_frame,
-        np.array(rows.new_linear_speed[:1]),
-        np.array(rows.new_zone[:1]),
+        rows.new_tool and lo == 0,
+        rows.new_frame and lo == 0,
+        np.array(rows.new_linear_speed[lo:hi]),
+        np.array(rows.new_zone[lo:hi]),
     )
 
 

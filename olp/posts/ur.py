@@ -91,6 +91,7 @@ from olp.posts.flow_text import (
 from olp.posts.numbers import NumberFormat
 from olp.posts.rows import PostRows, number_column
 from olp.posts.sandbox import SafeText
+from olp.posts.stream_transforms import BlendCapWindows
 from olp.posts.text import NUMBER, ArgumentRule, CommentRule, NameRule
 from olp.posts.ur_flow import UrWriter
 from olp.posts.view import RowColumns
@@ -449,9 +450,14 @@ class UrPost(Post):
     FILTERS: ClassVar[Mapping[str, Filter]] = FILTERS
     TRANSFORMS = (stop_at_block_boundaries, cap_blend_radii)
     ARC_ORIENTATIONS = frozenset({ArcOrientation.INTERPOLATE, ArcOrientation.PATH_CONSTANT})
+    WINDOW_TRANSFORMS = (BlendCapWindows,)
+    """Streamed programs have no control flow: ``stop_at_block_boundaries`` leaves them."""
     WRITES_FLOW = True
     COLUMNS = True
     WRITES_ROUTINES = True
+    STREAMS = True
+    STREAM_NEUTRAL_FILTERS = frozenset({"ur_pad"})
+    TOTAL_KINDS = frozenset({"program_too_long"})
 
     def __init__(self, manifest: Any) -> None:
         super().__init__(manifest)
@@ -505,10 +511,13 @@ class UrPost(Post):
             for decl, node in assigned_module_data(nodes)
         ]
         motions = sum(_emitted(item) for item in items_of(compiled.steps))
+        return found + self.check_totals(motions)
+
+    def check_totals(self, motions: int) -> list[Diagnostic]:
+        """``program_too_long`` (warning) for more than :data:`MAX_MOTIONS` motions."""
         if motions <= MAX_MOTIONS:
-            return found
+            return []
         return [
-            *found,
             Diagnostic(
                 "warning",
                 "program_too_long",
