@@ -247,24 +247,36 @@ def _laws(
 
         # The slowest law: caps for the peak speed and acceleration of the law without the
         # curvature terms (lowering the caps lowers both: the law with them holds them).
-        first = _joint_caps(limits, most, curve, np.zeros_like(slow), none, -1.0, jerk)
-        law = double_s(length, slow, np.minimum(first[0], tcp_slow), first[1])
-        slow_acc, slow_jerk = _joint_caps(limits, most, curve, law.peak, law.accel, -1.0, jerk)
-        slow_acc = np.minimum(slow_acc, tcp_slow)
+        # Without curvature terms (lines) no cap depends on a law's peak: all are the plain
+        # limits over the rates, and every relaxation below is the first.
+        curved = bool(np.any(curve > 0.0))
+        if curved:
+            first = _joint_caps(limits, most, curve, np.zeros_like(slow), none, -1.0, jerk)
+            law = double_s(length, slow, np.minimum(first[0], tcp_slow), first[1])
+            joint_slow = _joint_caps(limits, most, curve, law.peak, law.accel, -1.0, jerk)
+        else:
+            joint_slow = _plain_caps(limits, most, jerk)
+        slow_acc, slow_jerk = np.minimum(joint_slow[0], tcp_slow), joint_slow[1]
+        law = double_s(length, slow, slow_acc, slow_jerk)
         # The fastest: every law the limits allow peaks below the double S of a relaxation,
-        # so that peak bounds the curvature terms of the next, tighter relaxation. Without
-        # curvature terms the caps do not depend on the peak: every relaxation is the first.
+        # so that peak bounds the curvature terms of the next, tighter relaxation.
         peak = fast
-        for _ in range(_RELAXATIONS if relax and np.any(curve > 0.0) else 1):
-            fast_acc, fast_jerk = _joint_caps(limits, least, curve, peak, none, 1.0, jerk)
+        for _ in range(_RELAXATIONS if relax and curved else 1):
+            if curved:
+                fast_acc, fast_jerk = _joint_caps(limits, least, curve, peak, none, 1.0, jerk)
+            elif np.array_equal(least, most):
+                fast_acc, fast_jerk = joint_slow
+            else:
+                fast_acc, fast_jerk = _plain_caps(limits, least, jerk)
             fast_acc = np.minimum(fast_acc, tcp_fast(peak))
-            relaxed = double_s(length, fast, fast_acc, fast_jerk)
+            relaxed = _same_or_double_s(
+                law, (slow, slow_acc, slow_jerk), length, fast, fast_acc, fast_jerk
+            )
             peak = np.minimum(peak, relaxed.peak)
         clear = short_of_cruise(length, slow, slow_acc, slow_jerk) & short_of_cruise(
             length, fast, fast_acc, fast_jerk
         )
-    law = double_s(length, slow, slow_acc, slow_jerk)
-    best = relaxed.duration
+    best = relaxed.duration.copy()  # relaxed may be law: its rows change below
     feasible = (slow_acc > 0) & (slow_jerk > 0)
     lead = np.full(length.shape, -1, dtype=np.int64)
     accel, ramp, duration, jerk_time = law.accel / length, law.ramp, law.duration, law.jerk_time
@@ -336,7 +348,10 @@ def _screened_rates(
     k = 0.5 * half
     p0, p1 = _end_positions(moves, robot) if ends is None else ends
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        m = _derivative_bounds(_COUPLING_BOUND * np.sum(np.abs(line), axis=-1) / length, 0.0 * k)
+        norm1 = _COUPLING_BOUND * np.sum(np.abs(line), axis=-1) / length
+        m = [np.full(length.shape, _REACH_BOUND_M)]  # Mj = norm1^j R on a line
+        for _ in range(6):
+            m.append(m[-1] * norm1)
         chord = np.linalg.norm(p1 - p0, axis=-1) / length
         size = np.maximum(np.max(np.abs(p0), axis=-1), np.max(np.abs(p1), axis=-1))
         error = _FK_ERROR_M * (1.0 + size)
@@ -482,6 +497,30 @@ def _joint_caps(
     return acc, jerks
 
 
+def _plain_caps(limits: JointLimits, rate: FloatArray, jerk: bool) -> tuple[FloatArray, FloatArray]:
+    """:func:`_joint_caps` without curvature (``curve`` all 0: the same values):
+    ``min_j a_j / rate_j`` and ``min_j J_j / rate_j`` (M,) (``inf`` without ``jerk``)."""
+    acc = np.min(limits.acceleration / rate, axis=-1)
+    if not jerk:
+        return acc, np.full(acc.shape, np.inf)
+    return acc, np.min(limits.jerk / rate, axis=-1)
+
+
+def _same_or_double_s(
+    law: SCurves,
+    caps: tuple[FloatArray, FloatArray, FloatArray],
+    length: FloatArray,
+    speed: FloatArray,
+    accel: FloatArray,
+    jerk: FloatArray,
+) -> SCurves:
+    """``double_s(length, speed, accel, jerk)``: ``law`` itself where it was made from the same
+    ``caps`` (speed, acceleration, jerk) (the screened lines' fastest law is their slowest)."""
+    if all(np.array_equal(a, b) for a, b in zip(caps, (speed, accel, jerk), strict=True)):
+        return law
+    return double_s(length, speed, accel, jerk)
+
+
 def _times(curve: FloatArray, value: FloatArray) -> FloatArray:
     """``curve * value[:, None]`` (M, dof), exactly 0 where ``curve`` is 0 (``value`` may be
     ``inf`` there: a line's caps stay exactly the limits)."""
@@ -604,6 +643,8 @@ def straight_samples(
     sample count (M,) of each path."""
     if sizes.size == 0:
         return np.zeros(0, dtype=bool)
+    if np.all(sizes == 2):
+        return _straight_pairs(q[0::2], q[1::2], deviation)
     first = np.cumsum(sizes) - sizes
     chord = q[first + sizes - 1] - q[first]
     length = np.linalg.norm(chord, axis=-1)
@@ -616,6 +657,18 @@ def straight_samples(
     back[first] = 0.0  # a path's first sample follows another path's last
     worst = np.maximum.reduceat(np.maximum(off, back), first)
     return (worst <= deviation) & (length > _MIN_LINE_RAD)
+
+
+def _straight_pairs(q0: FloatArray, q1: FloatArray, deviation: float) -> NDArray[np.bool_]:
+    """:func:`straight_samples` of paths of two samples each, ``q0`` and ``q1`` (M, dof) rad,
+    with the same operations on the second sample (the first is the chord's start: 0 off it;
+    the second lies ahead of it, ``along >= 0``, so only its distance off the chord counts)."""
+    chord = q1 - q0
+    length = np.linalg.norm(chord, axis=-1)
+    unit = chord / np.maximum(length, _MIN_LINE_RAD)[:, None]
+    along = np.sum(chord * unit, axis=-1)
+    off = np.linalg.norm(chord - along[:, None] * unit, axis=-1)
+    return (np.maximum(off, 0.0) <= deviation) & (length > _MIN_LINE_RAD)
 
 
 _MIN_LINE_RAD = 1e-9

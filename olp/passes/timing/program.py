@@ -266,12 +266,11 @@ def time_lines(
     q0, q1 = paths.q0[straight], paths.q1[straight]
     bow, span = paths.bow[straight], paths.span[straight]
     robot = table.compiled.station.robot
-    tools = table.tools[table.tool[rows]]
     profiles = _line_profiles(
         q0,
         q1,
         robot,
-        tools,
+        (table.tools, table.tool[rows]),
         (
             table.linear[rows],
             table.angular[rows],
@@ -316,25 +315,27 @@ def _line_profiles(
     q0: FloatArray,
     q1: FloatArray,
     robot: Robot,
-    tools: FloatArray,
+    tools: tuple[FloatArray, IntArray],
     limits: tuple[FloatArray, FloatArray, FloatArray, FloatArray],
     jerk: bool,
     shapes: tuple[FloatArray, FloatArray],
     ends: tuple[FloatArray, FloatArray] | None = None,
 ) -> LineProfiles:
-    """:func:`line_profiles` in batches of :data:`LINE_ROWS` moves; ``limits``: the TCP's
-    linear and angular speeds and accelerations (M,) each; ``shapes``: the paths' bows
-    (M, dof) and spans (M,) (:func:`~olp.passes.timing.lines.line_paths`)."""
+    """:func:`line_profiles` in batches of :data:`LINE_ROWS` moves; ``tools``: the tool poses
+    (T, 4, 4) and each move's index (M,) into them (a batch's poses are made with the batch);
+    ``limits``: the TCP's linear and angular speeds and accelerations (M,) each; ``shapes``:
+    the paths' bows (M, dof) and spans (M,) (:func:`~olp.passes.timing.lines.line_paths`)."""
 
     linear, angular, linear_accel, angular_accel = limits
     bow, span = shapes
+    poses, tool = tools
 
     def batch(part: slice) -> LineProfiles:
         return line_profiles(
             q0[part],
             q1[part],
             robot,
-            tools[part],
+            poses[tool[part]],
             linear[part],
             angular[part],
             linear_accel[part],
