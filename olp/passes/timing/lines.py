@@ -86,7 +86,7 @@ def line_profiles(
     orientation acceleration ``angular_accel`` (M,) rad/s² (``inf`` or None: none) for the
     tools ``tools`` (M, 4, 4) (TCP in flange). ``ends``: the TCP positions (M, 3) m at ``q0``
     and at ``q1`` by forward kinematics, if the caller has them (NaN rows: not known); only
-    :func:`_screened` reads them.
+    :func:`_screened_rates` reads them.
 
     Jerk: joint j's jerk is ``e_j d³s/dt³``, so the joint jerk limits are exactly
     ``|d³s/dt³| <= min_j J_j / |e_j|`` and the law is a double S in ``s``
@@ -120,7 +120,7 @@ def line_profiles(
     changes by at most ``(c |e|_1)²`` per rad, likewise (used only where an orientation speed
     is given). Measured on the KR 6 helix: on 0.1 mm moves no TCP limit binds (exact); on
     2 mm moves at 50 mm/s the bound is < 1e-3. Most short lines of a toolpath never reach
-    their speed cap at all: :func:`_screened` proves that from the TCP positions at their
+    their speed cap at all: :func:`_screened_rates` proves that from the TCP positions at their
     ends and skips the five forward kinematics there (the result is the same to the bit).
 
     **Parabolas** (``bow`` (M, dof) rad and ``span`` (M,) rad, :func:`line_paths`): the path
@@ -208,7 +208,8 @@ def _laws(
     :func:`_line_rates`, and where each move stays short of its speed caps
     (:func:`~olp.passes.timing.scurve.short_of_cruise`: its law does not depend on them).
     ``relax``: a parabola's fastest law is relaxed :data:`_RELAXATIONS` times. Every row is
-    computed on its own (a subset of the moves gives the same rows)."""
+    computed on its own: a subset of the moves gives the same rows (the shortcuts taken for a
+    whole batch give the values they skip)."""
     line, length, bent = moves.q1 - moves.q0, moves.span, moves.bow
     start, end = (line - bent) / length[:, None], (line + bent) / length[:, None]
     most = np.maximum(np.abs(start), np.abs(end))  # max |q'_j| over the move
