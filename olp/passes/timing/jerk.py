@@ -41,7 +41,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from olp.passes.timing.problem import PathProblem
+from olp.passes.timing.problem import TINY_TANGENT, PathProblem
 from olp.passes.timing.scurve import double_s
 from olp.station.model import Robot
 from olp.trajectory import PathTimeLaw, SmoothedTimeLaw
@@ -59,8 +59,11 @@ def path_jerk(problem: PathProblem, robot: Robot) -> float:
     """The chain's path jerk limit ``min_s min_j J_j / |q'_j(s)|`` (1/s³ in units of ``s``) over
     its gridpoints (step 1 of the module docstring)."""
     dq = np.abs(problem.path(problem.grid, 1))
-    with np.errstate(divide="ignore"):
-        return float(np.min(robot.limits.jerk / dq))
+    limit = robot.limits.jerk
+    # A joint within TINY_TANGENT of standing still (a wrist axis kept on 0) limits nothing;
+    # its ratio would be above 1e100, or overflow.
+    moving = ~(dq <= limit * TINY_TANGENT)
+    return float(np.min(np.divide(limit, dq, out=np.full(dq.shape, np.inf), where=moving)))
 
 
 def scales(law: PathTimeLaw, jerk: float) -> tuple[float, float]:

@@ -7,13 +7,14 @@ import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from olp.geometry import rotation_log
-from olp.passes.timing.scurve import SCurves, double_s
-from olp.passes.timing.tcp import tcp_poses
+from olp.passes.timing.scurve import SCurves, double_s, short_of_cruise
+from olp.passes.timing.tcp import tcp_poses, tcp_positions
 from olp.station.model import JointLimits, Robot
 
 FloatArray = NDArray[np.float64]
@@ -50,6 +51,19 @@ class LineProfiles:
     jerk_time: FloatArray
     lead: NDArray[np.int64] | None = None
 
+    def with_rows(self, rows: NDArray[np.int64], other: LineProfiles) -> LineProfiles:
+        """These profiles with rows ``rows`` (k,) taken from ``other`` (k moves)."""
+        out: dict[str, Any] = {}
+        for name in ("accel", "ramp", "duration", "excess", "jerk_time", "lead"):
+            mine, theirs = getattr(self, name), getattr(other, name)
+            if mine is None or theirs is None:
+                out[name] = None
+                continue
+            mine = mine.copy()
+            mine[rows] = theirs
+            out[name] = mine
+        return LineProfiles(**out)
+
 
 def line_profiles(
     q0: FloatArray,
@@ -63,13 +77,16 @@ def line_profiles(
     jerk: bool = True,
     bow: FloatArray | None = None,
     span: FloatArray | None = None,
+    ends: tuple[FloatArray, FloatArray] | None = None,
 ) -> LineProfiles:
     """Time-optimal rest-to-rest laws along the straight joint lines ``q0 -> q1`` (M, dof) rad,
     vectorised over the moves, under the joint velocity, acceleration and (``jerk``) jerk
     limits, a TCP speed of at most ``linear_speed`` (M,) m/s and ``angular_speed`` (M,) rad/s
     and a TCP path (tangential) acceleration of at most ``linear_accel`` (M,) m/s² and
     orientation acceleration ``angular_accel`` (M,) rad/s² (``inf`` or None: none) for the
-    tools ``tools`` (M, 4, 4) (TCP in flange).
+    tools ``tools`` (M, 4, 4) (TCP in flange). ``ends``: the TCP positions (M, 3) m at ``q0``
+    and at ``q1`` by forward kinematics, if the caller has them (NaN rows: not known); only
+    :func:`_screened_rates` reads them.
 
     Jerk: joint j's jerk is ``e_j d³s/dt³``, so the joint jerk limits are exactly
     ``|d³s/dt³| <= min_j J_j / |e_j|`` and the law is a double S in ``s``
@@ -102,7 +119,9 @@ def line_profiles(
     :data:`_REACH_BOUND_M`, ``c`` :data:`_COUPLING_BOUND`). The orientation rate ``|J_w e|``
     changes by at most ``(c |e|_1)²`` per rad, likewise (used only where an orientation speed
     is given). Measured on the KR 6 helix: on 0.1 mm moves no TCP limit binds (exact); on
-    2 mm moves at 50 mm/s the bound is < 1e-3.
+    2 mm moves at 50 mm/s the bound is < 1e-3. Most short lines of a toolpath never reach
+    their speed cap at all: :func:`_screened_rates` proves that from the TCP positions at their
+    ends and skips the five forward kinematics there (the result is the same to the bit).
 
     **Parabolas** (``bow`` (M, dof) rad and ``span`` (M,) rad, :func:`line_paths`): the path
     ``q(s) = q0 + u line + u (u - 1) bow``, ``u = s / span``, the chain timer's spline through
@@ -117,19 +136,89 @@ def line_profiles(
     (:func:`_derivative_bounds`; ``(c |e|_1)^k R`` on a line). A parabola under an orientation
     limit is left to the solver (its excess is ``inf``).
     """
-    line = q1 - q0
-    length = np.linalg.norm(line, axis=-1) if span is None else span
-    bent = np.zeros_like(line) if bow is None else bow
+    none = np.full(q0.shape[0], np.inf)
+    moves = _Moves(
+        q0,
+        q1,
+        tools,
+        linear_speed,
+        angular_speed,
+        none if linear_accel is None else linear_accel,
+        none if angular_accel is None else angular_accel,
+        np.zeros_like(q0) if bow is None else bow,
+        np.linalg.norm(q1 - q0, axis=-1) if span is None else span,
+    )
+    relax = bow is not None
+    screenable = _screenable(moves)
+    screened = np.flatnonzero(screenable)
+    if screened.size == moves.count:  # a toolpath's short lines: all of them
+        rates = _screened_rates(moves, robot, ends)
+    else:
+        rates = np.empty((6, moves.count))
+        rates[:, screened] = _screened_rates(moves.take(screened), robot, _ends(ends, screened))
+        measured = np.flatnonzero(~screenable)
+        rates[:, measured] = _line_rates(moves.take(measured), robot)
+    profiles, clear = _laws(moves, robot.limits, jerk, rates, relax)
+    again = screened[~clear[screened]]
+    if again.size:  # the screen did not prove it: the five forward kinematics after all
+        part = moves.take(again)
+        redone, _ = _laws(part, robot.limits, jerk, _line_rates(part, robot), relax)
+        profiles = profiles.with_rows(again, redone)
+    return profiles
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class _Moves:
+    """The moves of :func:`line_profiles`, (M, ...) each: ends ``q0``, ``q1`` rad, ``tools``
+    (M, 4, 4), TCP limits (``inf``: none), ``bow`` (M, dof) rad (0 on a line), ``span`` rad."""
+
+    q0: FloatArray
+    q1: FloatArray
+    tools: FloatArray
+    linear: FloatArray
+    angular: FloatArray
+    linear_accel: FloatArray
+    angular_accel: FloatArray
+    bow: FloatArray
+    span: FloatArray
+
+    @property
+    def count(self) -> int:
+        return int(self.q0.shape[0])
+
+    @property
+    def turns(self) -> NDArray[np.bool_]:
+        """Where an orientation limit applies."""
+        return np.isfinite(self.angular) | np.isfinite(self.angular_accel)
+
+    def take(self, rows: NDArray[np.int64]) -> _Moves:
+        return _Moves(*(getattr(self, f.name)[rows] for f in dataclasses.fields(self)))
+
+
+def _ends(
+    ends: tuple[FloatArray, FloatArray] | None, rows: NDArray[np.int64]
+) -> tuple[FloatArray, FloatArray] | None:
+    return None if ends is None else (ends[0][rows], ends[1][rows])
+
+
+def _laws(
+    moves: _Moves, limits: JointLimits, jerk: bool, rates: FloatArray, relax: bool
+) -> tuple[LineProfiles, NDArray[np.bool_]]:
+    """The laws of :func:`line_profiles` given the TCP rate bounds ``rates`` (6, M) of
+    :func:`_line_rates`, and where each move stays short of its speed caps
+    (:func:`~olp.passes.timing.scurve.short_of_cruise`: its law does not depend on them).
+    ``relax``: a parabola's fastest law is relaxed :data:`_RELAXATIONS` times. Every row is
+    computed on its own: a subset of the moves gives the same rows (the shortcuts taken for a
+    whole batch give the values they skip)."""
+    line, length, bent = moves.q1 - moves.q0, moves.span, moves.bow
     start, end = (line - bent) / length[:, None], (line + bent) / length[:, None]
     most = np.maximum(np.abs(start), np.abs(end))  # max |q'_j| over the move
     least = np.where(start * end > 0.0, np.minimum(np.abs(start), np.abs(end)), 0.0)
     curve = 2.0 * np.abs(bent) / (length**2)[:, None]  # |q''_j|
     none = np.full(length.shape, np.inf)
-    lin_acc = none if linear_accel is None else linear_accel
-    ang_acc = none if angular_accel is None else angular_accel
-    limits = robot.limits
-    turns = np.isfinite(angular_speed) | np.isfinite(ang_acc)
-    rates = _line_rates(q0, q1, robot, tools, np.where(turns, 1.0, np.inf), bent, length)
+    lin_acc, ang_acc = moves.linear_accel, moves.angular_accel
+    linear_speed, angular_speed = moves.linear, moves.angular
+    turns = moves.turns
     rate_lo, rate_hi, turn_lo, turn_hi, bend, spin = rates
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         slow = np.minimum.reduce(
@@ -159,41 +248,136 @@ def line_profiles(
 
         # The slowest law: caps for the peak speed and acceleration of the law without the
         # curvature terms (lowering the caps lowers both: the law with them holds them).
-        first = _joint_caps(limits, most, curve, np.zeros_like(slow), none, -1.0, jerk)
-        law = double_s(length, slow, np.minimum(first[0], tcp_slow), first[1])
-        slow_acc, slow_jerk = _joint_caps(limits, most, curve, law.peak, law.accel, -1.0, jerk)
-        slow_acc = np.minimum(slow_acc, tcp_slow)
+        # Without curvature terms (lines) no cap depends on a law's peak: all are the plain
+        # limits over the rates, and every relaxation below is the first.
+        curved = bool(np.any(curve > 0.0))
+        if curved:
+            first = _joint_caps(limits, most, curve, np.zeros_like(slow), none, -1.0, jerk)
+            law = double_s(length, slow, np.minimum(first[0], tcp_slow), first[1])
+            joint_slow = _joint_caps(limits, most, curve, law.peak, law.accel, -1.0, jerk)
+        else:
+            joint_slow = _plain_caps(limits, most, jerk)
+        slow_acc, slow_jerk = np.minimum(joint_slow[0], tcp_slow), joint_slow[1]
+        law = double_s(length, slow, slow_acc, slow_jerk)
         # The fastest: every law the limits allow peaks below the double S of a relaxation,
         # so that peak bounds the curvature terms of the next, tighter relaxation.
         peak = fast
-        for _ in range(_RELAXATIONS if bow is not None else 1):
-            fast_acc, fast_jerk = _joint_caps(limits, least, curve, peak, none, 1.0, jerk)
+        for _ in range(_RELAXATIONS if relax and curved else 1):
+            if curved:
+                fast_acc, fast_jerk = _joint_caps(limits, least, curve, peak, none, 1.0, jerk)
+            elif np.array_equal(least, most):
+                fast_acc, fast_jerk = joint_slow
+            else:
+                fast_acc, fast_jerk = _plain_caps(limits, least, jerk)
             fast_acc = np.minimum(fast_acc, tcp_fast(peak))
-            relaxed = double_s(length, fast, fast_acc, fast_jerk)
+            relaxed = _same_or_double_s(
+                law, (slow, slow_acc, slow_jerk), length, fast, fast_acc, fast_jerk
+            )
             peak = np.minimum(peak, relaxed.peak)
-    law = double_s(length, slow, slow_acc, slow_jerk)
-    best = relaxed.duration
+        clear = short_of_cruise(length, slow, slow_acc, slow_jerk) & short_of_cruise(
+            length, fast, fast_acc, fast_jerk
+        )
+    best = relaxed.duration.copy()  # relaxed may be law: its rows change below
     feasible = (slow_acc > 0) & (slow_jerk > 0)
     lead = np.full(length.shape, -1, dtype=np.int64)
     accel, ramp, duration, jerk_time = law.accel / length, law.ramp, law.duration, law.jerk_time
-    if bow is not None:
-        feasible &= ~(turns & np.any(bow != 0.0, axis=-1))  # no orientation bound (above)
-        bowed = np.any(bow != 0.0, axis=-1)  # a straight line keeps its exact law above
-        led = _led(line, bow, limits, jerk, rate_hi * length, linear_speed, lin_acc, turns)
-        led = dataclasses.replace(led, ok=led.ok & bowed)
-        best = np.where(bowed, np.maximum(best, led.bound), best)
-        better = led.ok & (~feasible | (led.law.duration < duration))
-        lead = np.where(better, led.joint, -1)
-        accel = np.where(better, led.law.accel, accel)
-        ramp = np.where(better, led.law.ramp, ramp)
-        duration = np.where(better, led.law.duration, duration)
-        jerk_time = np.where(better, led.law.jerk_time, jerk_time)
-        feasible |= better
+    if relax:
+        bowed = np.any(bent != 0.0, axis=-1)  # a straight line keeps its exact law above
+        feasible &= ~(turns & bowed)  # no orientation bound (above)
+        rows = np.flatnonzero(bowed)  # the lead's law is read only on parabolas
+        led = _led(
+            line[rows],
+            bent[rows],
+            limits,
+            jerk,
+            (rate_hi * length)[rows],
+            linear_speed[rows],
+            lin_acc[rows],
+            turns[rows],
+        )
+        best[rows] = np.maximum(best[rows], led.bound)
+        better = led.ok & (~feasible[rows] | (led.law.duration < duration[rows]))
+        taken = rows[better]
+        lead[taken] = led.joint[better]
+        accel[taken] = led.law.accel[better]
+        ramp[taken] = led.law.ramp[better]
+        duration[taken] = led.law.duration[better]
+        jerk_time[taken] = led.law.jerk_time[better]
+        feasible[taken] = True
     with np.errstate(invalid="ignore"):
         excess = np.where(feasible, duration / best - 1.0, np.inf)
-    return LineProfiles(
+    profiles = LineProfiles(
         accel=accel, ramp=ramp, duration=duration, excess=excess, jerk_time=jerk_time, lead=lead
     )
+    return profiles, clear & (slow_acc > 0) & (slow_jerk > 0) & (fast_acc > 0) & (fast_jerk > 0)
+
+
+def _screenable(moves: _Moves) -> NDArray[np.bool_]:
+    """The moves whose law :func:`_screened_rates` may decide: straight lines without a TCP
+    acceleration or orientation limit (their law reads the TCP rates only through the speed
+    caps ``v / r``)."""
+    screenable: NDArray[np.bool_] = (
+        ~np.any(moves.bow != 0.0, axis=-1) & ~moves.turns & ~np.isfinite(moves.linear_accel)
+    )
+    return screenable
+
+
+def _screened_rates(
+    moves: _Moves, robot: Robot, ends: tuple[FloatArray, FloatArray] | None
+) -> FloatArray:
+    """Stand-ins (6, M) for :func:`_line_rates` on :func:`_screenable` moves, from the TCP
+    positions at their ends (``ends``, or forward kinematics): ``U`` as both rate bounds, 0 for
+    the rest, where ``U`` is at least the ``r_hi`` that :func:`_line_rates` computes.
+
+    Where the laws of :func:`_laws` with ``r_lo = r_hi = U`` stay short of their speed caps by
+    a margin (``clear``), so do the laws with the real bounds, and they are the same to the
+    bit: those caps are ``min(joint cap, v / r)`` and only higher with ``r <= U`` (division and
+    ``min`` round monotonically); a double S that does not reach its cap does not read it
+    (:func:`~olp.passes.timing.scurve.short_of_cruise`); nothing else of a screenable move's
+    law reads the rates. Elsewhere :func:`line_profiles` computes the real bounds.
+
+    The bound: ``|P1| + h |P2| + h² |P3| / 2 + rem`` bounds ``r_hi`` (``P1..P3`` as computed,
+    ``rem`` :func:`_remainder`); each ``Pj`` is the ``j``-th derivative at the middle within
+    its difference's remainder (all at most ``rem`` together) plus its stencil applied to the
+    forward kinematics' errors, at most ``η`` (:data:`_FK_ERROR_M`) each: ``1.5 η / k``,
+    ``5.4 η / k²``, ``3 η / k³``. With ``|p'| <= |p(q1) - p(q0)| / D + M2 D`` on the move,
+    ``|p''| <= M2``, ``|p'''| <= M3``: ``U = chord + M2 (D + h) + M3 h² / 2 + 2 rem
+    + 20 η / k``, and a relative ``1e-9`` for the rounding of the sums."""
+    line = moves.q1 - moves.q0
+    length = moves.span
+    half = 0.5 * length
+    k = 0.5 * half
+    p0, p1 = _end_positions(moves, robot) if ends is None else ends
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        norm1 = _COUPLING_BOUND * np.sum(np.abs(line), axis=-1) / length
+        m = [np.full(length.shape, _REACH_BOUND_M)]  # Mj = norm1^j R on a line
+        for _ in range(6):
+            m.append(m[-1] * norm1)
+        chord = np.linalg.norm(p1 - p0, axis=-1) / length
+        size = np.maximum(np.max(np.abs(p0), axis=-1), np.max(np.abs(p1), axis=-1))
+        error = _FK_ERROR_M * (1.0 + size)
+        bound = (
+            chord
+            + m[2] * (length + half)
+            + 0.5 * half**2 * m[3]
+            + 2.0 * _remainder(half, m)
+            + 20.0 * error / k
+        ) * (1.0 + 1e-9)
+    zero = np.zeros_like(bound)
+    return np.stack([bound, bound, zero, zero, zero, zero])
+
+
+_FK_ERROR_M = 1e-10
+"""m per m of distance from the world origin (plus one m): a bound on the error of a TCP
+position by forward kinematics, 1e5 times its rounding (tens of ulps of the largest term)."""
+
+
+def _end_positions(moves: _Moves, robot: Robot) -> tuple[FloatArray, FloatArray]:
+    """TCP positions (M, 3) m at the moves' ends, by forward kinematics."""
+    joints = np.concatenate([moves.q0, moves.q1])
+    tools = np.concatenate([moves.tools, moves.tools])
+    positions = tcp_positions(robot, joints, tools)
+    return positions[: moves.count], positions[moves.count :]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -314,6 +498,30 @@ def _joint_caps(
     return acc, jerks
 
 
+def _plain_caps(limits: JointLimits, rate: FloatArray, jerk: bool) -> tuple[FloatArray, FloatArray]:
+    """:func:`_joint_caps` without curvature (``curve`` all 0: the same values):
+    ``min_j a_j / rate_j`` and ``min_j J_j / rate_j`` (M,) (``inf`` without ``jerk``)."""
+    acc = np.min(limits.acceleration / rate, axis=-1)
+    if not jerk:
+        return acc, np.full(acc.shape, np.inf)
+    return acc, np.min(limits.jerk / rate, axis=-1)
+
+
+def _same_or_double_s(
+    law: SCurves,
+    caps: tuple[FloatArray, FloatArray, FloatArray],
+    length: FloatArray,
+    speed: FloatArray,
+    accel: FloatArray,
+    jerk: FloatArray,
+) -> SCurves:
+    """``double_s(length, speed, accel, jerk)``: ``law`` itself where it was made from the same
+    ``caps`` (speed, acceleration, jerk) (the screened lines' fastest law is their slowest)."""
+    if all(np.array_equal(a, b) for a, b in zip(caps, (speed, accel, jerk), strict=True)):
+        return law
+    return double_s(length, speed, accel, jerk)
+
+
 def _times(curve: FloatArray, value: FloatArray) -> FloatArray:
     """``curve * value[:, None]`` (M, dof), exactly 0 where ``curve`` is 0 (``value`` may be
     ``inf`` there: a line's caps stay exactly the limits)."""
@@ -338,21 +546,15 @@ def trapezoid(length: FloatArray, peak: FloatArray, accel: FloatArray) -> tuple[
     return ramp, np.where(cruise, length / peak + peak / accel, 2.0 * ramp)
 
 
-def _line_rates(
-    q0: FloatArray,
-    q1: FloatArray,
-    robot: Robot,
-    tools: FloatArray,
-    angular_speed: FloatArray,
-    bow: FloatArray,
-    length: FloatArray,
-) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
+def _line_rates(moves: _Moves, robot: Robot) -> FloatArray:
     """Bounds (M,) on the TCP's linear rate (m/rad) and orientation rate (rad/rad) along the
-    joint lines ``q0 -> q1`` (parabolas with ``bow`` (M, dof) rad over ``length`` (M,) rad of
-    path parameter): low and high of each, and upper bounds on the magnitude of their
-    derivatives along the path, ``|p''|`` (m/rad²) and ``(c |e|_1)²`` (rad/rad², lines only)
-    (see :func:`line_profiles`)."""
-    line = q1 - q0
+    joint lines ``q0 -> q1`` of ``moves`` (parabolas with ``bow`` (M, dof) rad over ``span``
+    (M,) rad of path parameter): low and high of each, and upper bounds on the magnitude of
+    their derivatives along the path, ``|p''|`` (m/rad²) and ``(c |e|_1)²`` (rad/rad², lines
+    only), as rows (6, M) (see :func:`line_profiles`); the orientation's only where
+    ``moves.turns``."""
+    q0, tools, bow, length = moves.q0, moves.tools, moves.bow, moves.span
+    line = moves.q1 - q0
     half = 0.5 * length
     k = 0.5 * half
     widest = np.maximum(np.sum(np.abs(line - bow), axis=-1), np.sum(np.abs(line + bow), axis=-1))
@@ -374,20 +576,22 @@ def _line_rates(
     rate_lo = np.sqrt(np.maximum(rate2 - along, 0.0)) - rest
     rate_hi = np.sqrt(rate2 + along + across) + rest
     turn = np.zeros_like(length)
-    limited = np.isfinite(angular_speed)
+    limited = moves.turns
     if np.any(limited):
         rotations = poses[:, :3, :3].reshape(5, -1, 3, 3)
         relative = np.swapaxes(rotations[0][limited], -1, -2) @ rotations[4][limited]
         turn[limited] = np.linalg.norm(rotation_log(relative), axis=-1) / length[limited]
     spread = half * norm1**2 * (1.0 + half * norm1)
     bend_hi = np.linalg.norm(bend, axis=-1) + half * np.linalg.norm(twist, axis=-1) + half**2 * m[4]
-    return (
-        np.maximum(rate_lo, 0.0),
-        rate_hi,
-        np.maximum(turn - spread, 0.0),
-        turn + spread,
-        bend_hi,
-        norm1**2,
+    return np.stack(
+        [
+            np.maximum(rate_lo, 0.0),
+            rate_hi,
+            np.maximum(turn - spread, 0.0),
+            turn + spread,
+            bend_hi,
+            norm1**2,
+        ]
     )
 
 
@@ -440,6 +644,8 @@ def straight_samples(
     sample count (M,) of each path."""
     if sizes.size == 0:
         return np.zeros(0, dtype=bool)
+    if np.all(sizes == 2):
+        return _straight_pairs(q[0::2], q[1::2], deviation)
     first = np.cumsum(sizes) - sizes
     chord = q[first + sizes - 1] - q[first]
     length = np.linalg.norm(chord, axis=-1)
@@ -452,6 +658,18 @@ def straight_samples(
     back[first] = 0.0  # a path's first sample follows another path's last
     worst = np.maximum.reduceat(np.maximum(off, back), first)
     return (worst <= deviation) & (length > _MIN_LINE_RAD)
+
+
+def _straight_pairs(q0: FloatArray, q1: FloatArray, deviation: float) -> NDArray[np.bool_]:
+    """:func:`straight_samples` of paths of two samples each, ``q0`` and ``q1`` (M, dof) rad,
+    with the same operations on the second sample (the first is the chord's start: 0 off it;
+    the second lies ahead of it, ``along >= 0``, so only its distance off the chord counts)."""
+    chord = q1 - q0
+    length = np.linalg.norm(chord, axis=-1)
+    unit = chord / np.maximum(length, _MIN_LINE_RAD)[:, None]
+    along = np.sum(chord * unit, axis=-1)
+    off = np.linalg.norm(chord - along[:, None] * unit, axis=-1)
+    return (np.maximum(off, 0.0) <= deviation) & (length > _MIN_LINE_RAD)
 
 
 _MIN_LINE_RAD = 1e-9

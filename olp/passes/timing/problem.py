@@ -58,11 +58,27 @@ def speed_bounds(
     ``|q'_j| ds/dt <= v_j`` and the TCP speeds ``rate ds/dt <= limit`` (:func:`tcp_rates` for
     ``tools`` (4, 4) or (K, 4, 4); ``linear`` m/s and ``angular`` rad/s (K,), ``inf``: none);
     capped at ``X_CAP``."""
-    with np.errstate(divide="ignore"):
-        bound = np.min((robot.limits.velocity / np.abs(dq)) ** 2, axis=-1)
+    bound = joint_speed_bound(robot.limits.velocity, dq)
     turns = bool(np.any(np.isfinite(angular)))
     linear_rate, angular_rate = tcp_rates(robot, tools, q, dq, angular=turns)
     bound = np.minimum(bound, rate_bound(linear_rate, linear))
     if turns:
         bound = np.minimum(bound, rate_bound(angular_rate, angular))
     return np.minimum(bound, X_CAP)
+
+
+def joint_speed_bound(velocity: FloatArray, dq: FloatArray) -> FloatArray:
+    """``min_j (v_j / |q'_j|)²`` (K,) for joint velocity limits ``velocity`` (dof,) rad/s and
+    tangents ``dq`` (K, dof): a joint with ``|q'_j| <= v_j * TINY_TANGENT`` (one standing
+    still, or within 1e-300 of it where a wrist axis stays on 0) bounds nothing (``inf``; its
+    ratio squared would be ``1e200`` or more, far above ``X_CAP``, or overflow)."""
+    rate = np.abs(dq)
+    moving = ~(rate <= velocity * TINY_TANGENT)  # NaN counts as moving: it stays NaN
+    ratio = np.divide(velocity, rate, out=np.full(rate.shape, np.inf), where=moving)
+    out: FloatArray = np.min(ratio**2, axis=-1)
+    return out
+
+
+TINY_TANGENT = 1e-100
+"""Relative to a joint's limit, the smallest ``|q'_j|`` divided by (see
+:func:`joint_speed_bound`); any ``(limit / |q'_j|)²`` it leaves out is above ``1e200``."""

@@ -46,6 +46,7 @@ from olp.passes.timing.table import (
     below_floor,
     gather,
     plan,
+    sample_positions,
     travel,
 )
 from olp.station.model import Robot
@@ -141,13 +142,14 @@ def time_program(
         zone = table.zone.copy()
         zone[stops] = 0.0
         table = dataclasses.replace(table, zone=zone)
-    lengths = travel(table, compiled.station.robot)
+    positions = sample_positions(table, compiled.station.robot)
+    lengths = travel(table, compiled.station.robot, positions)
     corners = plan(table, lengths)
     times = Times(table.size)
     opts = options or TimingOptions()
     time_fixed(table, time_table(other_times), times)
     found = time_joints(table, lengths, times)
-    found += time_paths(table, lengths, corners, opts, times)
+    found += time_paths(table, lengths, corners, opts, times, positions)
     joint_blends = None if ur.applies(table) else ptp_blend.blended_joint_moves(table, lengths)
     found.sort(key=lambda d: d.index if d.index is not None else -1)
     found += _overflow(compiled, times.duration)
@@ -224,9 +226,11 @@ def time_paths(
     corners: Plan,
     options: TimingOptions,
     out: Times,
+    positions: FloatArray | None = None,
 ) -> list[Diagnostic]:
     """Path moves: the stop-to-stop ones along straight joint lines in closed form, the other
-    chains by the path solver."""
+    chains by the path solver. ``positions`` (S, 3) m: the TCP at every sample of
+    ``table.q``, if known (:func:`~olp.passes.timing.table.sample_positions`)."""
     sizes = corners.sizes
     firsts = corners.rows[corners.bounds[:-1]]
     lone = (sizes == 1) & ~below_floor(table, firsts)  # a too-slow move: the chain timer says so
@@ -240,7 +244,7 @@ def time_paths(
         done = np.isin(firsts, rows)
         lone &= ~done
     if options.straight_lines and np.any(lone):
-        done[lone] = time_lines(table, lengths, firsts[lone], options, out)
+        done[lone] = time_lines(table, lengths, firsts[lone], options, out, positions)
     return time_chains(table, corners, np.flatnonzero(~done), options, out)
 
 
@@ -250,10 +254,11 @@ def time_lines(
     rows: IntArray,
     options: TimingOptions,
     out: Times,
+    positions: FloatArray | None = None,
 ) -> NDArray[np.bool_]:
     """Time stop-to-stop path moves ``rows`` that run along a straight joint line in closed
     form, all at once; returns which rows were timed (the others: not straight, or an error
-    bound above ``line_tolerance``)."""
+    bound above ``line_tolerance``). ``positions``: as :func:`time_paths`."""
     q, sizes = gather(table, rows)
     paths = line_paths(q, sizes, options.line_deviation_rad)
     straight = paths.timed
@@ -261,12 +266,11 @@ def time_lines(
     q0, q1 = paths.q0[straight], paths.q1[straight]
     bow, span = paths.bow[straight], paths.span[straight]
     robot = table.compiled.station.robot
-    tools = table.tools[table.tool[rows]]
     profiles = _line_profiles(
         q0,
         q1,
         robot,
-        tools,
+        (table.tools, table.tool[rows]),
         (
             table.linear[rows],
             table.angular[rows],
@@ -275,6 +279,7 @@ def time_lines(
         ),
         options.path_jerk,
         (bow, span),
+        None if positions is None else _end_positions(table, rows, positions),
     )
     bowed = np.any(bow != 0.0, axis=-1)
     ok = profiles.excess <= np.where(bowed, options.curve_tolerance, options.line_tolerance)
@@ -301,33 +306,36 @@ def time_lines(
 
 
 LINE_ROWS = 1 << 14
-"""Moves per batch of :func:`line_profiles` (five forward kinematics each: about 10 kB of
-temporaries per move, so a batch holds ~160 MB at most; all moves of a 100k toolpath at once
-took 330 MB)."""
+"""Moves per batch of :func:`line_profiles` (up to five forward kinematics each: about 10 kB
+of temporaries per move, so a batch holds ~160 MB at most; all moves of a 100k toolpath at
+once took 330 MB)."""
 
 
 def _line_profiles(
     q0: FloatArray,
     q1: FloatArray,
     robot: Robot,
-    tools: FloatArray,
+    tools: tuple[FloatArray, IntArray],
     limits: tuple[FloatArray, FloatArray, FloatArray, FloatArray],
     jerk: bool,
     shapes: tuple[FloatArray, FloatArray],
+    ends: tuple[FloatArray, FloatArray] | None = None,
 ) -> LineProfiles:
-    """:func:`line_profiles` in batches of :data:`LINE_ROWS` moves; ``limits``: the TCP's
-    linear and angular speeds and accelerations (M,) each; ``shapes``: the paths' bows
-    (M, dof) and spans (M,) (:func:`~olp.passes.timing.lines.line_paths`)."""
+    """:func:`line_profiles` in batches of :data:`LINE_ROWS` moves; ``tools``: the tool poses
+    (T, 4, 4) and each move's index (M,) into them (a batch's poses are made with the batch);
+    ``limits``: the TCP's linear and angular speeds and accelerations (M,) each; ``shapes``:
+    the paths' bows (M, dof) and spans (M,) (:func:`~olp.passes.timing.lines.line_paths`)."""
 
     linear, angular, linear_accel, angular_accel = limits
     bow, span = shapes
+    poses, tool = tools
 
     def batch(part: slice) -> LineProfiles:
         return line_profiles(
             q0[part],
             q1[part],
             robot,
-            tools[part],
+            poses[tool[part]],
             linear[part],
             angular[part],
             linear_accel[part],
@@ -335,6 +343,7 @@ def _line_profiles(
             jerk=jerk,
             bow=bow[part],
             span=span[part],
+            ends=None if ends is None else (ends[0][part], ends[1][part]),
         )
 
     parts = [batch(slice(lo, lo + LINE_ROWS)) for lo in range(0, len(q0), LINE_ROWS)]
@@ -345,6 +354,19 @@ def _line_profiles(
             np.concatenate([getattr(p, f) for p in parts])
             for f in ("accel", "ramp", "duration", "excess", "jerk_time", "lead")
         )
+    )
+
+
+def _end_positions(
+    table: MotionTable, rows: IntArray, positions: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """The TCP positions (M, 3) m at the first and last samples of motions ``rows``, from the
+    samples' ``positions``; NaN where a sample's tool is not the motion's (not known)."""
+    lo, hi = table.lo[rows], table.hi[rows]
+    own = (table.sample_tool[lo] == table.tool[rows]) & (table.sample_tool[hi] == table.tool[rows])
+    return (
+        np.where(own[:, None], positions[lo], np.nan),
+        np.where(own[:, None], positions[hi], np.nan),
     )
 
 

@@ -209,12 +209,28 @@ def _stage_caps(rows: _StageRows) -> FloatArray:
     with np.errstate(divide="ignore", invalid="ignore"):
         for here, after in _batches(rows.stages):
             c, w = rows.at(here, after)
-            best = np.min(np.where(w > 0, c / w, np.inf), axis=1)
+            best = np.min(np.where(w > 0, _quotient(c, w), np.inf), axis=1)
             for k in range(c.shape[1] - 1):  # row k against each later row, all stages at once
-                pairs = (c[:, k : k + 1] + c[:, k + 1 :]) / np.abs(w[:, k : k + 1] - w[:, k + 1 :])
+                pairs = _quotient(
+                    c[:, k : k + 1] + c[:, k + 1 :], np.abs(w[:, k : k + 1] - w[:, k + 1 :])
+                )
                 np.minimum(best, np.min(pairs, axis=1), out=best)
             out[here] = best
     return out
+
+
+def _quotient(num: FloatArray, den: FloatArray) -> FloatArray:
+    """``num / den`` for ``num >= 0`` (NaN and ``0 / 0`` as numpy gives them), ``inf`` where
+    ``den`` is below ``num * _TINY_QUOTIENT``: such a bound on ``x`` is above ``1e100``, far
+    above the cap :data:`~olp.passes.timing.plan.X_CAP` every ``x`` is held under, and the
+    division would overflow (a wrist axis that stays within 1e-300 rad of 0 has such rows)."""
+    keep = ~(den <= num * _TINY_QUOTIENT) | (num == 0.0)
+    out = np.full(np.broadcast(num, den).shape, np.inf)
+    return np.divide(num, den, out=out, where=keep)
+
+
+_TINY_QUOTIENT = 1e-100
+"""See :func:`_quotient`."""
 
 
 def _backward(rows: _StageRows, bound: FloatArray) -> FloatArray:
@@ -225,7 +241,7 @@ def _backward(rows: _StageRows, bound: FloatArray) -> FloatArray:
     def step(i: Stages, j: Stages) -> FloatArray:
         c, w = rows.at(i, j)
         with np.errstate(divide="ignore", invalid="ignore"):
-            brake = np.where(w < 0, (out[j][:, None] + c) / -w, np.inf)
+            brake = np.where(w < 0, _quotient(out[j][:, None] + c, -w), np.inf)
         return np.minimum(out[i], np.min(brake, axis=1))
 
     def one(i: int, c: list[float], w: list[float]) -> float:

@@ -47,9 +47,7 @@ def double_s(length: FloatArray, speed: FloatArray, accel: FloatArray, jerk: Flo
         *(np.asarray(x, dtype=np.float64) for x in (length, speed, accel, jerk))
     )
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        reach = v * j >= a**2
-        tj_cruise = np.where(reach, a / j, np.sqrt(v / j))
-        ta_cruise = np.where(reach, v / a + tj_cruise, 2.0 * tj_cruise)
+        reach, tj_cruise, ta_cruise = _cruise_ramp(v, a, j)
         cruise = d >= v * ta_cruise
         tj_a = a / j
         peak_a = 0.5 * a * (np.sqrt(tj_a**2 + 4.0 * d / a) - tj_a)
@@ -62,3 +60,35 @@ def double_s(length: FloatArray, speed: FloatArray, accel: FloatArray, jerk: Flo
         ramp = peak / ap + tj
         duration = np.where(cruise, d / v + ramp, 2.0 * ramp)
     return SCurves(tj, ramp, duration, peak, ap)
+
+
+def _cruise_ramp(
+    v: FloatArray, a: FloatArray, j: FloatArray
+) -> tuple[NDArray[np.bool_], FloatArray, FloatArray]:
+    """Whether a ramp to ``v`` reaches ``a``, its jerk phase and its duration ``Ta`` (s)."""
+    reach = v * j >= a**2
+    tj_cruise = np.where(reach, a / j, np.sqrt(v / j))
+    ta_cruise = np.where(reach, v / a + tj_cruise, 2.0 * tj_cruise)
+    return reach, tj_cruise, ta_cruise
+
+
+def short_of_cruise(
+    length: FloatArray, speed: FloatArray, accel: FloatArray, jerk: FloatArray
+) -> NDArray[np.bool_]:
+    """Where the double S over ``length`` with ``speed``, ``accel``, ``jerk`` (M,) each peaks
+    below ``speed`` with a margin: so does the one with any higher speed cap, and all of them
+    are the same law to the bit (:func:`double_s` reads ``speed`` only where it cruises).
+
+    :func:`double_s` cruises where ``length >= V Ta(V)``, as rounded. ``V Ta(V)`` rounds
+    monotonically in ``V`` on each side of ``V J = A²``, and across it ``Ta`` is continuous
+    (``2 A / J`` from both sides), so rounding can lower it by a few ulps there at most;
+    :data:`CRUISE_CLEARANCE` is far above that."""
+    v, a, j = (np.asarray(x, dtype=np.float64) for x in (speed, accel, jerk))
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        ta = _cruise_ramp(v, a, j)[2]
+        short: NDArray[np.bool_] = length < v * ta * (1.0 - CRUISE_CLEARANCE)
+    return short
+
+
+CRUISE_CLEARANCE = 1e-9
+"""Relative margin of :func:`short_of_cruise` below the distance a ramp to the cap covers."""

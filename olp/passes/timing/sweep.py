@@ -14,7 +14,7 @@ from olp.compiled import CompiledProgram
 from olp.ir import CircularMove, JointMove, LinearMove
 from olp.passes.timing.plan import TimingOptions, time_table
 from olp.passes.timing.program import Times, time_fixed, time_joints, time_paths
-from olp.passes.timing.table import JOINT, MotionTable, plan, travel
+from olp.passes.timing.table import JOINT, MotionTable, plan, sample_positions, travel
 from olp.transforms.blend import with_step_instructions
 
 if TYPE_CHECKING:
@@ -62,7 +62,8 @@ def speed_sweep(
     :func:`path_sweep` times it per path.
     """
     table = MotionTable.of(compiled)
-    lengths = travel(table, compiled.station.robot)
+    positions = sample_positions(table, compiled.station.robot)
+    lengths = travel(table, compiled.station.robot, positions)
     corners = plan(table, lengths)
     opts = options or TimingOptions()
     total, done = len(linear_speeds) + len(joint_speeds), 0
@@ -73,7 +74,8 @@ def speed_sweep(
         if joint:
             found = time_joints(table.with_speeds(None, value), lengths, times)
         else:
-            found = time_paths(table.with_speeds(value, None), lengths, corners, opts, times)
+            paths = table.with_speeds(value, None)
+            found = time_paths(paths, lengths, corners, opts, times, positions)
         done += 1
         if progress is not None:
             progress(done, total)

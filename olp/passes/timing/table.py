@@ -211,9 +211,9 @@ def _or_inf(value: float | None, default: float | None = None) -> float:
     return np.inf if value is None else value
 
 
-def travel(table: MotionTable, robot: Robot) -> FloatArray:
-    """TCP travel (n,) m of every motion along its samples (0 for other rows): forward
-    kinematics of all samples in batches of ``FK_ROWS``."""
+def sample_positions(table: MotionTable, robot: Robot) -> FloatArray:
+    """TCP positions (S, 3) m of all samples ``table.q`` with their tools: forward kinematics
+    in batches of ``FK_ROWS``."""
     count = len(table.q)
     positions = np.empty((count, 3))
     with np.errstate(over="ignore", invalid="ignore"):  # a tool 1e308 m long: inf
@@ -221,6 +221,15 @@ def travel(table: MotionTable, robot: Robot) -> FloatArray:
             part = slice(lo, lo + FK_ROWS)
             tools = table.tools[table.sample_tool[part]]
             positions[part] = (robot.flange_poses(table.q[part]) @ tools)[:, :3, 3]
+    return positions
+
+
+def travel(table: MotionTable, robot: Robot, positions: FloatArray | None = None) -> FloatArray:
+    """TCP travel (n,) m of every motion along its samples (0 for other rows), from the
+    samples' TCP positions (:func:`sample_positions` if not given)."""
+    if positions is None:
+        positions = sample_positions(table, robot)
+    with np.errstate(over="ignore", invalid="ignore"):  # a tool 1e308 m long: inf
         steps = np.linalg.norm(np.diff(positions, axis=0), axis=-1)
         arc = np.concatenate([[0.0], np.cumsum(steps)])
         out = np.zeros(table.size)
