@@ -18,6 +18,7 @@ from olp.api import BuildResult
 from olp.errors import ParseError
 from olp.frontends.krl import KrlResult, parse_krl, rows
 from olp.station.model import Station
+from tests.compile_once import CompileOnce
 
 REPO = Path(__file__).resolve().parents[2]
 HEADER = [
@@ -92,14 +93,21 @@ def test_a_long_program_reads_as_linear_paths_with_the_same_moves(
     assert dense.ignored == plain.ignored and dense.notes == plain.notes
 
 
+@pytest.fixture(scope="module")
+def compile_once() -> CompileOnce:
+    """Each program of ``both`` compiled once for all the posts."""
+    return CompileOnce()
+
+
 @pytest.mark.parametrize("post", ["kuka", "abb", "ur", "fanuc"])
 def test_a_long_program_builds_byte_identical_files_on_every_post(
-    both: tuple[KrlResult, KrlResult], station: Station, post: str
+    both: tuple[KrlResult, KrlResult], station: Station, post: str, compile_once: CompileOnce
 ) -> None:
     dense, plain = both
-    built: list[BuildResult] = [
-        olp.build(station, r.program, post, collisions=None) for r in (dense, plain)
-    ]
+    with compile_once:
+        built: list[BuildResult] = [
+            olp.build(station, r.program, post, collisions=None) for r in (dense, plain)
+        ]
     assert built[0].ok and built[0].files
     assert built[0].files == built[1].files
     assert [repr(d) for d in built[0].diagnostics] == [repr(d) for d in built[1].diagnostics]

@@ -22,7 +22,8 @@ from olp.posts.base import Post
 from olp.posts.rows import spell_column
 from olp.posts.view import Names, ProgramView, RowColumns
 from olp.vendors.abb import confdata
-from tests.posts.test_row_columns import _forbidden, _toolpath
+from tests.compile_once import CompileOnce
+from tests.posts.test_row_columns import PART_LIMITS, _forbidden, _post, _toolpath
 
 REPO = Path(__file__).resolve().parents[2]
 KR6_CELL = REPO / "stations" / "kr6_milling_cell.yaml"
@@ -93,7 +94,9 @@ def _both(
     writer (each move a template pass)."""
     manifest = post.manifest
     template = type(post)(dataclasses.replace(manifest, rows=False))
-    return olp.build(station, program, type(post)(manifest)), olp.build(station, program, template)
+    with CompileOnce():
+        columns = olp.build(station, program, type(post)(manifest))
+        return columns, olp.build(station, program, template)
 
 
 def _assert_same(
@@ -121,9 +124,11 @@ def test_a_toolpath_with_changes_is_written_by_columns(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """Custom speeds with an orientation limit (``_o45``), custom zones, a path acceleration,
-    a move with another tool and frame before the toolpath; 5000 rows: split in parts."""
+    a move with another tool and frame before the toolpath; more rows than a file holds (a
+    smaller file limit): split in parts."""
     station = olp.load_station(KR6_CELL)
-    files = _assert_same(find_post("abb"), station, _toolpath(5000, tmp_path), monkeypatch)
+    post = _post("abb", PART_LIMITS)
+    files = _assert_same(post, station, _toolpath(800, tmp_path), monkeypatch)
     assert len(files) > 2
     text = "".join(files.values())
     for piece in ("_o45", "PathAccLim TRUE", "LOCAL CONST zonedata z", "\\WObj:=fixture"):

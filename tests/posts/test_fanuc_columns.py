@@ -24,21 +24,30 @@ from olp.posts.fanuc import NUMBERS, FanucPost
 from olp.posts.numbers import NumberFormat
 from olp.posts.render import RenderError
 from olp.station.model import Station
+from olp.transforms.limits import SplitLimits
+from tests.compile_once import CompileOnce
 
 REPO = Path(__file__).resolve().parents[2]
 KUKA_CELL = REPO / "stations" / "kr6_milling_cell.yaml"
 FANUC_CELL = REPO / "stations" / "fanuc_m20ia_weld_cell.yaml"
+PART_LIMITS = SplitLimits(max_instructions=300)
+"""A file limit below the helix's rows, so the toolpath is cut between parts: the post's own
+3000 would need thousands of rows (the build time grows with the rows)."""
 
 
 def _forbidden(*args: object) -> None:
     raise AssertionError("a toolpath's rows were made into steps")
 
 
-def _posts(post: Post | None = None, **options: Any) -> tuple[Post, Post, Post]:
+def _posts(
+    post: Post | None = None, limits: SplitLimits | None = None, **options: Any
+) -> tuple[Post, Post, Post]:
     """The post three ways: columns (the bundled folder), rows without columns (the PostRows
-    writer) and the templates alone (``rows: false``)."""
+    writer) and the templates alone (``rows: false``); ``limits`` instead of the post's."""
     post = post or find_post("fanuc")
     manifest = dataclasses.replace(post.manifest, options={**post.manifest.options, **options})
+    if limits is not None:
+        manifest = dataclasses.replace(manifest, limits=limits)
     cls = type(post)
     rows_only = type("RowsOnly", (cls,), {"COLUMNS": False})
     return cls(manifest), rows_only(manifest), cls(dataclasses.replace(manifest, rows=False))
@@ -80,9 +89,11 @@ def _helix(rows: int, tmp_path: Path) -> ir.Program:
 def test_a_helix_is_written_by_columns_as_the_templates_write_it(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    program = _helix(7000, tmp_path)
+    count = 700
+    program = _helix(count, tmp_path)
     station = olp.load_station(KUKA_CELL)
-    results = [olp.build(station, program, post) for post in _posts()]
+    with CompileOnce():
+        results = [olp.build(station, program, post) for post in _posts(limits=PART_LIMITS)]
     columns, rows, template = results
     assert columns.ok, [d.format() for d in columns.diagnostics]
     assert len(columns.files) == 4  # split in three parts and a main: the toolpath is cut
@@ -94,11 +105,11 @@ def test_a_helix_is_written_by_columns_as_the_templates_write_it(
         assert columns.files == other.files
         assert [d.format() for d in columns.diagnostics] == [d.format() for d in other.diagnostics]
     raised = [d for d in columns.diagnostics if d.kind == "speed_raised"]
-    assert len(raised) == len(range(5, 7000, 97))
+    assert len(raised) == len(range(5, count, 97))
     # The column build made no step per row: the same build again, with that forbidden.
     monkeypatch.setattr(PathBlock, "steps", _forbidden)
     monkeypatch.setattr(CompiledProgram, "flat", _forbidden)
-    again = olp.build(station, program, find_post("fanuc"))
+    again = olp.build(station, program, _posts(limits=PART_LIMITS)[0])
     assert again.files == columns.files
     assert [d.format() for d in again.diagnostics] == [d.format() for d in columns.diagnostics]
 

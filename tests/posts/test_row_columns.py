@@ -17,12 +17,18 @@ from olp.compiled import CompiledProgram, PathBlock
 from olp.frontends.bundled import CsvOptions
 from olp.geometry import transl
 from olp.posts import REGISTRY, find_post
+from olp.posts.base import Post
 from olp.posts.numbers import NumberError, NumberFormat, format_number
 from olp.posts.rows import number_column, spell_column
+from olp.transforms.limits import SplitLimits
+from tests.compile_once import CompileOnce
 
 REPO = Path(__file__).resolve().parents[2]
 CELL = REPO / "stations" / "kr6_milling_cell.yaml"
 COLUMN_POSTS = ["kuka", "abb"]  # column writers that split files (UR: test_ur_columns.py)
+PART_LIMITS = SplitLimits(max_motions=300)
+"""A file limit below a toolpath's rows, so the block is cut between parts: the posts' own 5000
+would need 5000 rows (the build time grows with the rows)."""
 
 EDGES = [0.0, -0.0, -0.0004, -0.0005, 0.0005, 0.00049999, 1e-320, -1e-320, 2.5, -2.5, 0.125]
 EDGES += [1e15, -1e17, 123456789.0125, 0.0015, 1.0005, 2.675, 1e300, -1e301, 0.5, -0.5, 9.9995]
@@ -104,21 +110,24 @@ def _toolpath(rows: int, tmp_path: Path) -> ir.Program:
     return program.replace_instructions([*rest, *head, node, *tail])
 
 
-def _both(post_name: str, program: ir.Program, **options: object) -> tuple[olp.BuildResult, ...]:
+def _both(
+    post_name: str, program: ir.Program, limits: SplitLimits | None = None, **options: object
+) -> tuple[olp.BuildResult, ...]:
     station = olp.load_station(CELL)
-    post = find_post(post_name)
+    post = _post(post_name, limits)
     manifest = dataclasses.replace(post.manifest, options={**post.manifest.options, **options})
     columns = type(post)(manifest)
     template = type(post)(dataclasses.replace(manifest, rows=False))
-    return olp.build(station, program, columns), olp.build(station, program, template)
+    with CompileOnce():
+        return olp.build(station, program, columns), olp.build(station, program, template)
 
 
 @pytest.mark.parametrize("post", COLUMN_POSTS)
 def test_a_toolpath_is_written_by_columns_as_the_templates_write_it(
     post: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    program = _toolpath(5000, tmp_path)
-    columns, template = _both(post, program)
+    program = _toolpath(800, tmp_path)
+    columns, template = _both(post, program, PART_LIMITS)
     assert columns.ok, [d.format() for d in columns.diagnostics]
     assert len(columns.files) > 2  # split: the block is cut between files
     assert columns.files == template.files
@@ -127,7 +136,15 @@ def test_a_toolpath_is_written_by_columns_as_the_templates_write_it(
     monkeypatch.setattr(PathBlock, "steps", _forbidden)
     monkeypatch.setattr(CompiledProgram, "flat", _forbidden)
     station = olp.load_station(CELL)
-    assert olp.build(station, program, find_post(post)).files == columns.files
+    assert olp.build(station, program, _post(post, PART_LIMITS)).files == columns.files
+
+
+def _post(name: str, limits: SplitLimits | None = None) -> Post:
+    """The bundled post ``name``, with ``limits`` instead of its own where given."""
+    post = find_post(name)
+    if limits is None:
+        return post
+    return type(post)(dataclasses.replace(post.manifest, limits=limits))
 
 
 def _forbidden(*args: object) -> None:

@@ -23,6 +23,7 @@ from olp.posts import find_post
 from olp.posts.rows import spell_column
 from olp.posts.ur import UrPost, _blends_filter
 from olp.posts.view import Names, PostStep, ProgramView, RowColumns, build_steps
+from tests.compile_once import CompileOnce
 
 REPO = Path(__file__).resolve().parents[2]
 CELL = REPO / "stations" / "kr6_milling_cell.yaml"
@@ -96,11 +97,12 @@ def _builds(program: ir.Program, post: UrPost | None = None) -> tuple[Any, Any, 
     assert isinstance(ur, UrPost)
     manifest = ur.manifest
     templates = UrPost(dataclasses.replace(manifest, rows=False))
-    return (
-        olp.build(station, program, post or ur),
-        olp.build(station, program, _StepPath(manifest)),
-        olp.build(station, program, templates),
-    )
+    with CompileOnce():
+        return (
+            olp.build(station, program, post or ur),
+            olp.build(station, program, _StepPath(manifest)),
+            olp.build(station, program, templates),
+        )
 
 
 def _forbidden(*args: object) -> None:
