@@ -344,12 +344,17 @@ class Motions(InlineForms):
         """A motion olp models after a BAS kept as written (one given run-time values) in the
         same straight stretch: the BAS changed the controller's settings behind the output's
         back, and the posts write a setting only where it differs from the previous motion's,
-        so this motion could run with the BAS's values. An error naming the BAS."""
+        so this motion could run with the BAS's values. An error naming the BAS.
+
+        The look back ends at the previous motion too: that one was checked the same way, so
+        nothing before it can be such a BAS (one scan per motion, not one over the whole
+        straight stretch: a pendant program of thousands of motions was quadratic)."""
         for node in reversed(self.out):
             if isinstance(node, (ir.Label, *ir.BLOCK_TYPES)):
                 return
-            if isinstance(node, ir.RuntimeMove) and node.controller_settings:
-                return  # the output writes every setting of the motion after one again
+            if isinstance(node, (Pending, PendingRows, ir.RuntimeMove, *ir.MOTION_TYPES)):
+                return  # (after a run-time motion with the controller's settings, the output
+                # writes every setting of the next motion again)
             if isinstance(node, ir.Verbatim) and node.reason.startswith("BAS #"):
                 raise self._error(
                     f"this motion follows {node.text} (line {node.span.line}), kept as written "
