@@ -517,3 +517,11 @@ def test_nesting_too_deep_is_a_parse_error() -> None:
     error = parse_error("x = " + "-" * 3000 + "1")
     assert error.span is not None and error.span.line == 1
     assert "nested too deeply" in error.message
+
+
+def test_a_lone_carriage_return_inside_a_kept_statement_is_a_located_error() -> None:
+    """Found by test_fuzz_random_text: ``$OUT[1]=<CR>$`` reached :class:`olp.ir.Verbatim`,
+    which refuses a line break, as a FlowError traceback instead of a located error."""
+    with pytest.raises(ParseError, match="not one clean line") as caught:
+        parse_krl("DEF t( )\n$OUT[1]=\r$\nEND\n", "t.src")
+    assert caught.value.span is not None and caught.value.span.line == 2

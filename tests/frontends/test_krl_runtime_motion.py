@@ -149,3 +149,27 @@ def test_the_pendant_home_without_config_dat_runs_with_the_controller_settings()
 def test_with_config_dat_the_pendant_home_is_modelled() -> None:
     result = lower(*PENDANT_HOME, *AGAIN, config=load_config_dat(CONFIG))
     assert runtime(result) == [] and len(list(result.program.motions())) == 2
+
+
+PDAT = "DECL PDAT pMine={VEL 100.0,ACC 35.0,APO_DIST 500.0,APO_MODE #CDIS,GEAR_JERK 100.0}"
+
+
+def test_a_known_record_a_kept_bas_reads_is_written_before_it() -> None:
+    """``PDAT_ACT = pMine`` (known: the module declares it) beside ``FDAT_ACT = FHOME`` (no
+    ``$config.dat``): the BAS is kept as written and reads both records, so the known one's
+    assignment, which olp absorbs into the motions elsewhere, is written before it (before: it
+    was left out and the BAS read whatever PDAT_ACT the controller held)."""
+    body = (PDAT, "PDAT_ACT=pMine", "FDAT_ACT=FHOME", "BAS (#PTP_PARAMS,100 )", "PTP  XHOME")
+    result = lower(*body, *AGAIN)
+    nodes = list(result.program)
+    bas = next(i for i, n in enumerate(nodes) if isinstance(n, ir.Verbatim))
+    before = [n.target for n in nodes[:bas] if isinstance(n, ir.Assign)]
+    assert [t.name for t in before if isinstance(t, ir.Name)] == ["FDAT_ACT", "PDAT_ACT"]
+    pdat = next(n for n in nodes[:bas] if isinstance(n, ir.Assign) and n.span.line == 3)
+    assert pdat.value == ir.Name(name="pMine", span=pdat.value.span)
+
+
+def test_a_known_record_set_member_by_member_before_a_kept_bas_is_an_error() -> None:
+    body = (PDAT, "PDAT_ACT=pMine", "PDAT_ACT.VEL=50", "FDAT_ACT=FHOME")
+    with pytest.raises(ParseError, match="this BAS reads PDAT_ACT, whose value olp knows"):
+        lower(*body, "BAS (#PTP_PARAMS,100 )", "PTP  XHOME")

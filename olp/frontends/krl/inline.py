@@ -22,6 +22,7 @@ from olp.frontends.krl.ast import (
 )
 from olp.frontends.krl.state import (
     SYSTEM_REASONS,
+    WRITTEN,
     Core,
 )
 from olp.frontends.krl.values import (
@@ -99,7 +100,12 @@ class InlineForms(Core):
     def _bas_at_run_time(self, stmt: CallStmt, command: str, reason: str) -> None:
         """Keep a BAS command with run-time values as written: the KRL post writes it back;
         the motion settings it sets are unknown from here on, so a motion that relies on them
-        is an error, and a module without one (a settings routine) builds."""
+        is an error, and a module without one (a settings routine) builds.
+
+        The records it reads that olp knows (``PDAT_ACT = PDEFAULT`` beside a run-time
+        ``FDAT_ACT = FHOME``) had their assignments absorbed into the motions: they are written
+        before it, or the BAS would read whatever the controller held."""
+        self._write_absorbed_records(stmt, command)
         self._keep(stmt, f"BAS #{command} with a value known only at run time ({reason})")
         kept = self.out[-1]
         assert isinstance(kept, ir.Verbatim)
@@ -111,6 +117,25 @@ class InlineForms(Core):
                 ambiguous[field_name] = why
         if {"tool", "frame"} & set(_BAS_SETS[command]):
             self.track.lose_cartesian(f"$TOOL/$BASE were set at run time at line {stmt.span.line}")
+
+    def _write_absorbed_records(self, stmt: CallStmt, command: str) -> None:
+        for read in _BAS_READS.get(command, ()):
+            if read == "value" or self._runtime(self.variables.lookup(read)):
+                continue
+            absorbed = self.absorbed_data.get(read, WRITTEN)
+            if absorbed == WRITTEN:  # (or never assigned: the output left it as olp assumes)
+                continue
+            if not isinstance(absorbed, Assign):
+                raise self._error(
+                    f"this BAS reads {read}, whose value olp knows but cannot write back here "
+                    "(assigned member by member, or in another block): the BAS is kept as written "
+                    f"(it also reads a value known only at run time), so it would read a {read} "
+                    "the output never set",
+                    stmt.span,
+                    hint=f"assign {read} a whole record right before the BAS",
+                )
+            self.out.append(self._assignment(absorbed))
+            self.absorbed_data[read] = WRITTEN
 
     def _bas_handlers(self) -> dict[str, Callable[[CallStmt], None]]:
         return {

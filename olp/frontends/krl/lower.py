@@ -656,6 +656,7 @@ class _Lowering(Motions, Events):
         child.loop_depth = self.loop_depth + (1 if loop else 0)
         child.loops = [*self.loops, "block"] if loop else list(self.loops)
         child.ambiguous = dict(self.ambiguous)
+        child.absorbed_data = dict(self.absorbed_data)
         child.routine = self.routine
         child.defining, child.generic = self.defining, self.generic
         child.return_ends = [] if probe else self.return_ends
@@ -717,6 +718,10 @@ class _Lowering(Motions, Events):
             else:
                 reason = f"{name} depends on the path through {where}"
                 self.variables.assign(name, joined(values, reason))
+        for c in children:  # a record one path sets is written back only by its own path
+            for name, absorbed in c.absorbed_data.items():
+                if self.absorbed_data.get(name) is not absorbed:
+                    self.absorbed_data[name] = None
         self._merge_states(reached, where)
 
     def _merge_states(self, ends: Sequence[_Lowering], where: str) -> None:

@@ -236,6 +236,9 @@ CONFIG_DAT_DATA = frozenset({"FHOME", "PDEFAULT", "LDEFAULT"})
 """Inline-form data every KR C4 ``$config.dat`` declares (``DECL FDAT FHOME``: all seven
 controller backups of benchmarks/krl_corpus.py that hold one; ``PDEFAULT``/``LDEFAULT``: the
 defaults the pendant's inline forms name)."""
+WRITTEN = "written"
+"""An inline-form record whose value the output has set (``absorbed_data``)."""
+
 INLINE_FORM_DATA = frozenset({"PDAT_ACT", "LDAT_ACT", "FDAT_ACT"})
 """What the pendant's inline forms assign for BAS to read: absorbed into the motions' speeds,
 zones, tools and bases (:mod:`olp.frontends.krl.inline`), not kept as assignments."""
@@ -376,6 +379,10 @@ class Core:
         self.here_vars: dict[str, tuple[str, int]] = {}  # name -> ($POS_ACT..., motion_count)
         # the last BAS kept as written (run-time values) and the motion settings when it ran
         self.kept_bas: tuple[ir.Verbatim, State] | None = None
+        # the last assignment of each inline-form record olp absorbed into the motions, for a
+        # BAS kept as written: None where it cannot be written back alone (a member's),
+        # WRITTEN once the output holds the record's value
+        self.absorbed_data: dict[str, Assign | str | None] = {}
         self._setters: dict[str, Callable[[str, Expr, Stmt], None]] = {
             "$VEL.CP": self._set_vel_cp,
             "$ACC.CP": self._set_acc_cp,
@@ -429,7 +436,15 @@ class Core:
         """Keep a statement olp does not model as :class:`~olp.ir.Verbatim` (its text without
         the comment): the KRL post writes it back, other posts stop on it."""
         text = self.sources.snippet(stmt.span).split(";", 1)[0].strip()
-        self.out.append(ir.Verbatim(text=text, language="krl", reason=reason, span=stmt.span))
+        try:
+            kept = ir.Verbatim(text=text, language="krl", reason=reason, span=stmt.span)
+        except ir.FlowError as exc:  # a control character (a lone carriage return) inside it
+            raise self._error(
+                f"olp keeps this statement as written, but it is not one clean line: {exc}",
+                stmt.span,
+                hint="remove the control character from the statement",
+            ) from None
+        self.out.append(kept)
 
     def _note(self, span: ir.SourceSpan, message: str, once: str | None = None) -> None:
         key = ("note", once) if once is not None else ("note", span, message)
@@ -518,6 +533,9 @@ class Core:
                 # PDAT_ACT = pdatNew with a run-time value: the BAS reading it is kept as
                 # written, so the assignment must reach the output too
                 self.out.append(self._assignment(stmt))
+                self.absorbed_data[name] = WRITTEN
+            else:
+                self.absorbed_data[name] = None if stmt.target.selectors else stmt
 
     def _config_data_at_run_time(self, name: str, stmt: Assign) -> None:
         """``FDAT_ACT = FHOME`` (``PDEFAULT``, ``LDEFAULT``: :data:`CONFIG_DAT_DATA`) without a
