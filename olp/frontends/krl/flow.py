@@ -173,14 +173,11 @@ def joined(values: Sequence[Value], reason: str) -> Value:
     return past if past is not None else Unknown(reason)
 
 
-def reads_value(nodes: Sequence[Any], name: str) -> bool:
-    """Whether lowered ``nodes`` read the variable ``name`` (an assignment to it as a whole
-    writes it, not reads it): a :class:`ir.Name` in any expression, or the word in a statement
-    kept as text (a verbatim line, a call's arguments)."""
+def reads_name(nodes: Sequence[Any], name: str) -> bool:
+    """Whether lowered ``nodes`` read the variable ``name``: a :class:`ir.Name` in any of their
+    expressions, or the word in a statement kept as text (a verbatim line, a call's arguments)."""
     word = re.compile(rf"(?<![\w$]){re.escape(name)}(?![\w$])", re.IGNORECASE)
-    pending: list[Any] = [
-        n.value if isinstance(n, ir.Assign) and isinstance(n.target, ir.Name) else n for n in nodes
-    ]
+    pending: list[Any] = list(nodes)
     while pending:
         node = pending.pop()
         if isinstance(node, ir.Name):
@@ -194,3 +191,12 @@ def reads_value(nodes: Sequence[Any], name: str) -> bool:
         elif dataclasses.is_dataclass(node) and not isinstance(node, ir.SourceSpan):
             pending.extend(getattr(node, f.name) for f in dataclasses.fields(node))
     return False
+
+
+def reads_value(nodes: Sequence[Any], name: str) -> bool:
+    """Whether lowered ``nodes`` read the variable ``name``, an assignment to it as a whole
+    writing it, not reading it (:func:`reads_name` of the rest)."""
+    values = [
+        n.value if isinstance(n, ir.Assign) and isinstance(n.target, ir.Name) else n for n in nodes
+    ]
+    return reads_name(values, name)

@@ -55,6 +55,7 @@ from olp.frontends.krl.flow import (
     joined,
     jump_targets,
     past_for,
+    reads_name,
     reads_value,
     statements,
     to_expr,
@@ -1029,26 +1030,6 @@ def _count_assign(stmt: ForLoop, count: int) -> ir.Assign:
         value=ir.Constant(value=count, span=stmt.span),
         span=stmt.span,
     )
-
-
-def reads_name(nodes: Sequence[Any], name: str) -> bool:
-    """Whether lowered ``nodes`` read the variable ``name``: a :class:`ir.Name` in any of their
-    expressions, or the word in a statement kept as text (a verbatim line, a call's arguments)."""
-    word = re.compile(rf"(?<![\w$]){re.escape(name)}(?![\w$])", re.IGNORECASE)
-    pending: list[Any] = list(nodes)
-    while pending:
-        node = pending.pop()
-        if isinstance(node, ir.Name):
-            if node.name.upper() == name.upper():
-                return True
-        elif isinstance(node, str):
-            if word.search(node):
-                return True
-        elif isinstance(node, (tuple, list)):
-            pending.extend(node)
-        elif dataclasses.is_dataclass(node) and not isinstance(node, ir.SourceSpan):
-            pending.extend(getattr(node, f.name) for f in dataclasses.fields(node))
-    return False
 
 
 def _module_name(src: str, routines: Sequence[Routine]) -> str:
