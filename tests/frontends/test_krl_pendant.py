@@ -81,6 +81,7 @@ def pick(config: KrlData) -> KrlResult:
 def test_pick_reads_the_dat_and_config(pick: KrlResult) -> None:
     kinds = [(type(i).__name__, i.span.line) for i in pick.program.expanded()]
     assert kinds == [
+        ("Verbatim", 27),  # $H_POS=XHOME: kept as written (the controller's $IN_HOME)
         ("JointMove", 28),  # PTP XHOME
         ("Verbatim", 36),  # SET_CD_PARAMS (0): kept as written
         ("JointMove", 37),  # PTP XP1 C_PTP
@@ -99,6 +100,7 @@ def test_pick_reads_the_dat_and_config(pick: KrlResult) -> None:
         ("Wait", 97),
         ("Verbatim", 103),
         ("LinearMove", 104),
+        ("Verbatim", 80),
         ("JointMove", 81),  # back in the main program: PTP XHOME
     ]
     assert pick.data_sources == (str(CONFIG), str(EXAMPLES / "pendant_pick.dat"))
@@ -181,7 +183,8 @@ def test_pick_lists_every_ignored_line_with_a_reason(pick: KrlResult) -> None:
     ]
     kept = [(i.span.line, i.text) for i in pick.program.expanded() if isinstance(i, ir.Verbatim)]
     lines = [36, 44, 61, 69, 91, 103]  # SET_CD_PARAMS: kept in the program as written
-    assert kept == [(line, "SET_CD_PARAMS (0)") for line in lines]
+    homes = [(27, "$H_POS=XHOME")], [(80, "$H_POS=XHOME")]  # the pendant's PTP HOME folds
+    assert kept == [*homes[0], *[(line, "SET_CD_PARAMS (0)") for line in lines], *homes[1]]
     assert not [line for line, text in src if text.startswith("SET_CD_PARAMS")]
     assert by_file["pendant_pick.dat"] == [
         (9, "EXT  BAS (BAS_COMMAND  :IN,REAL  :IN )"),

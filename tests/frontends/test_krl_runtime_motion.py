@@ -136,7 +136,7 @@ def test_the_pendant_home_without_config_dat_runs_with_the_controller_settings()
     assert home.controller_settings and home.motion == "joint" and home.span.line == 6
     assert "$config.dat" in home.reason and "BAS (#PTP_PARAMS,100 )" in home.reason
     kept = [n for n in result.program if isinstance(n, ir.Verbatim)]
-    assert [n.text for n in kept] == ["BAS (#PTP_PARAMS,100 )"]
+    assert [n.text for n in kept] == ["BAS (#PTP_PARAMS,100 )", "$H_POS=XHOME"]
     assigned = [n for n in result.program if isinstance(n, ir.Assign)]
     assert [n.target for n in assigned] == [
         ir.Name(name="PDAT_ACT", span=assigned[0].target.span),

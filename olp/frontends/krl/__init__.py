@@ -77,7 +77,8 @@ What is lowered
   comment is a comment; the lines inside it are lowered: ``PDAT_ACT=PPDAT1``/``LDAT_ACT=...``/
   ``FDAT_ACT=FP1`` (assignments), ``BAS(#PTP_PARAMS, v)`` (FDAT_ACT's TOOL_NO, BASE_NO,
   IPO_FRAME; joint speed ``v`` %, PDAT_ACT's ACC % and APO_DIST mm), ``BAS(#CP_PARAMS, v)``
-  (frames; ``$VEL.CP = v`` m/s, LDAT_ACT's APO_DIST mm), ``$H_POS=XHOME``, the motion.
+  (frames; ``$VEL.CP = v`` m/s, LDAT_ACT's APO_DIST mm), ``$H_POS=XHOME`` (also kept as
+  written: the controller's home for its ``$IN_HOME`` output), the motion.
   ``BAS(#FRAMES|#PTP_DAT|#CP_DAT|#VEL_CP|#VEL_PTP|#ACC_PTP|#TOOL|#BASE, ...)`` likewise.
   The spline inline forms' ``WITH $VEL_AXIS[1] = SVEL_JOINT(100.0), $TOOL = STOOL2(FP1),
   $BASE = SBASE(FP1.BASE_NO), $APO = SAPO_PTP(PPDAT1), ...`` are read, for that motion only.

@@ -673,8 +673,13 @@ class Core:
         self._output(signal.index, stmt.value, stmt)
 
     def _set_home(self, name: str, value: Expr, stmt: Stmt) -> None:
+        """``$H_POS = XHOME``: olp learns the home position (for ``PTP $H_POS``) and keeps the
+        line as written: the controller compares the robot with ``$H_POS`` for its
+        ``$IN_HOME`` output, which a PLC may read, so the line is not absorbed silently."""
         home = self._value(value)
         self.variables.globals["$H_POS"] = home
+        if isinstance(stmt, Assign):
+            self._keep(stmt, "$H_POS sets the controller's home position (its $IN_HOME output)")
 
     def _set_ipo_mode(self, name: str, value: Expr, stmt: Stmt) -> None:
         self._ipo_mode(self._value(value), value.span)
