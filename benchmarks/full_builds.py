@@ -25,6 +25,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -58,16 +59,17 @@ def helix(points: int, path: Path) -> None:
     np.savetxt(path, xyz, fmt="%.4f", delimiter=",", header="x,y,z", comments="")
 
 
-def run_olp(*args: str, code: Path | None = None) -> tuple[float, float, int]:
-    """Wall time (s), peak memory (MB) and exit code of ``olp ARGS`` in a fresh interpreter
-    (``code``: a folder holding another ``olp`` package, imported instead of this one)."""
+def child_line(child: str, args: Sequence[str], code: Path | None) -> tuple[str | None, str]:
+    """Run the script ``child`` with ``args`` in a fresh interpreter with one BLAS/OpenMP
+    thread (``code``: a folder holding another ``olp`` package, imported instead of this one):
+    the ``@@ ...`` line it prints on stderr (None if it printed none) and the stderr's end."""
     env = {**os.environ, "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "CI": "1"}
     if code is not None:
         env["PYTHONPATH"] = str(code)
     # From the repository's parent: the working folder comes first on the import path, so a
     # run from the repository would import this code even where ``code`` names another.
     done = subprocess.run(
-        [sys.executable, "-c", CHILD, *args],
+        [sys.executable, "-c", child, *args],
         capture_output=True,
         text=True,
         env=env,
@@ -75,8 +77,15 @@ def run_olp(*args: str, code: Path | None = None) -> tuple[float, float, int]:
         cwd=REPO.parent,
     )
     line = next((x for x in done.stderr.splitlines() if x.startswith("@@ ")), None)
+    return line, done.stderr[-2000:]
+
+
+def run_olp(*args: str, code: Path | None = None) -> tuple[float, float, int]:
+    """Wall time (s), peak memory (MB) and exit code of ``olp ARGS`` in a fresh interpreter
+    (``code``: a folder holding another ``olp`` package, imported instead of this one)."""
+    line, tail = child_line(CHILD, args, code)
     if line is None:
-        raise SystemExit(f"olp {' '.join(args)} failed:\n{done.stderr[-2000:]}")
+        raise SystemExit(f"olp {' '.join(args)} failed:\n{tail}")
     wall, peak, code = line.split()[1:]
     return float(wall), float(peak), int(code)
 

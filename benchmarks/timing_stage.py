@@ -21,14 +21,12 @@ from __future__ import annotations
 
 import argparse
 import filecmp
-import os
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from full_builds import CELL, ORIENTATION, REPO
+from full_builds import CELL, ORIENTATION, child_line
 from scaling import helix, label
 
 CHILD = r"""
@@ -67,25 +65,13 @@ print(f"@@ {spent['timing']:.4f} {spent['writer']:.4f} {code}", file=sys.stderr)
 
 def stages(csv: Path, out: Path, code: Path | None) -> tuple[float, float]:
     """CPU seconds in the timing stage and in the writer of one build."""
-    env = {**os.environ, "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "CI": "1"}
-    if code is not None:
-        env["PYTHONPATH"] = str(code)
     args = [
         "build", str(CELL), str(csv), "--frame", "table", "--orientation", ORIENTATION,
         "--post", "kuka", "-o", str(out), "--quiet",
     ]  # fmt: skip
-    # From the repository's parent, so that ``code`` (not the working folder) is imported.
-    done = subprocess.run(
-        [sys.executable, "-c", CHILD, *args],
-        capture_output=True,
-        text=True,
-        env=env,
-        check=False,
-        cwd=REPO.parent,
-    )
-    line = next((x for x in done.stderr.splitlines() if x.startswith("@@ ")), None)
+    line, tail = child_line(CHILD, args, code)
     if line is None or line.split()[3] != "0":
-        raise SystemExit(f"olp {' '.join(args)} failed:\n{done.stderr[-2000:]}")
+        raise SystemExit(f"olp {' '.join(args)} failed:\n{tail}")
     timing, writer = line.split()[1:3]
     return float(timing), float(writer)
 

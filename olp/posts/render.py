@@ -227,13 +227,7 @@ class _Renderer:
         reserved = [*self.post.PREDEFINED_NAMES, *self.post.reserved_names(self.compiled)]
         names = Names(rule, [self.name, *unit_names, *reserved])
         options = self.manifest.options
-        entry = names.take(str(options["entry"])) if "entry" in options else self.name
-        routines = [
-            names.take(str(options.get("part_routine", "{name}")).format(name=n))
-            if "part_routine" in options
-            else n
-            for n in unit_names
-        ]
+        entry, routines = entry_names(names, options, self.name, unit_names)
         allocation = self.view.allocate(names)
         if not split:
             out = self._files(self.manifest.files, self._unit(parts[0], allocation, 0, 0, entry))
@@ -412,3 +406,19 @@ def line_endings(text: str, ending: str) -> str:
     """``text`` with every line's trailing blanks dropped and lines ended by ``ending``."""
     lines = text.replace("\r\n", "\n").split("\n")
     return ending.join(line.rstrip() for line in lines)
+
+
+def entry_names(
+    names: Names, options: Mapping[str, Any], name: str, unit_names: Sequence[str]
+) -> tuple[str, list[str]]:
+    """The program's entry routine name (the post option ``entry``, else ``name``) and each
+    part's routine name (the option ``part_routine``, a ``{name}`` pattern, else the part's),
+    taken from ``names`` in this order (a streamed build takes them as the whole render does)."""
+    entry = names.take(str(options["entry"])) if "entry" in options else name
+    routines = [
+        names.take(str(options.get("part_routine", "{name}")).format(name=n))
+        if "part_routine" in options
+        else n
+        for n in unit_names
+    ]
+    return entry, routines

@@ -77,6 +77,7 @@ from olp.posts.render import (
     Unit,
     _unique,
     _used,
+    entry_names,
     line_endings,
     render_templates,
     unit_context,
@@ -93,8 +94,7 @@ from olp.posts.view import (
     PostTool,
     ProgramView,
     RowColumns,
-    _changed_object,
-    _changed_value,
+    row_changes,
 )
 from olp.transforms.split import SplitLimits, part_names
 
@@ -420,22 +420,7 @@ class StreamedRender:
         :meth:`ProgramView._rows` computes them)."""
         assert self.named is not None and self.named.tool is not None
         assert self.named.frame is not None
-        block, node = piece.block, piece.block.node
-        new_tool = _changed_object(last, "tool", block.tool)
-        new_frame = _changed_object(last, "frame", block.frame)
-        zones = node.zones[piece.lo : piece.hi]
-        speeds = node.speeds[piece.lo : piece.hi]
-        new_zone = np.empty(len(piece), dtype=bool)
-        from olp.ir import Zone
-
-        new_zone[0] = _changed_value(last, "zone", Zone(float(zones[0])))
-        new_zone[1:] = zones[1:] != zones[:-1]
-        last["zone"] = Zone(float(zones[-1]))
-        rest = (node.angular, node.acceleration, node.angular_acceleration)
-        new_speed = np.empty(len(piece), dtype=bool)
-        new_speed[0] = _changed_value(last, "linear_speed", (float(speeds[0]), *rest))
-        new_speed[1:] = speeds[1:] != speeds[:-1]
-        last["linear_speed"] = (float(speeds[-1]), *rest)
+        new_tool, new_frame, new_speed, new_zone = row_changes(piece, last)
         first = motions.number + piece.lo
         names = self._row_names(first, len(piece))
         return RowColumns(
@@ -609,13 +594,7 @@ class StreamedRender:
         head = self.head_program
         reserved = [*post.PREDEFINED_NAMES, *(post.reserved_names(head) if head else ())]
         names = Names(post.NAME_RULE, [self.name, *unit_names, *reserved])
-        entry = names.take(str(options["entry"])) if "entry" in options else self.name
-        routines = [
-            names.take(str(options.get("part_routine", "{name}")).format(name=n))
-            if "part_routine" in options
-            else n
-            for n in unit_names
-        ]
+        entry, routines = entry_names(names, options, self.name, unit_names)
         allocation = self.view.allocate(names)
         prefix, suffix = self.pattern
         taken: list[str] = []

@@ -545,21 +545,8 @@ class ProgramView:
         """A toolpath's rows as columns, their change flags computed over the arrays (the rows
         share one tool and frame; angular speed and accelerations are the block's)."""
         block = piece.block
-        node = block.node
         named = names.blocks[block.start]
-        new_tool = _changed_object(last, "tool", block.tool)
-        new_frame = _changed_object(last, "frame", block.frame)
-        zones = node.zones[piece.lo : piece.hi]
-        speeds = node.speeds[piece.lo : piece.hi]
-        new_zone = np.empty(len(piece), dtype=bool)
-        new_zone[0] = _changed_value(last, "zone", Zone(float(zones[0])))
-        new_zone[1:] = zones[1:] != zones[:-1]
-        last["zone"] = Zone(float(zones[-1]))
-        rest = (node.angular, node.acceleration, node.angular_acceleration)
-        new_speed = np.empty(len(piece), dtype=bool)
-        new_speed[0] = _changed_value(last, "linear_speed", (float(speeds[0]), *rest))
-        new_speed[1:] = speeds[1:] != speeds[:-1]
-        last["linear_speed"] = (float(speeds[-1]), *rest)
+        new_tool, new_frame, new_speed, new_zone = row_changes(piece, last)
         return RowColumns(
             piece,
             self.blocks[block.start],
@@ -651,6 +638,29 @@ def _settings_changed(step: Step, joint: bool, last: dict[str, Any]) -> _Flags:
         new_joint_speed=new_joint_speed,
         new_linear_speed=new_linear_speed,
     )
+
+
+def row_changes(
+    piece: BlockRows, last: dict[str, Any]
+) -> tuple[bool, bool, NDArray[np.bool_], NDArray[np.bool_]]:
+    """Which of a toolpath piece's settings change: its tool and frame (once, the rows share
+    them) and, per row, its speed and zone, against the previous motion's (``last``, which it
+    updates to the piece's last row)."""
+    block, node = piece.block, piece.block.node
+    new_tool = _changed_object(last, "tool", block.tool)
+    new_frame = _changed_object(last, "frame", block.frame)
+    zones = node.zones[piece.lo : piece.hi]
+    speeds = node.speeds[piece.lo : piece.hi]
+    new_zone = np.empty(len(piece), dtype=bool)
+    new_zone[0] = _changed_value(last, "zone", Zone(float(zones[0])))
+    new_zone[1:] = zones[1:] != zones[:-1]
+    last["zone"] = Zone(float(zones[-1]))
+    rest = (node.angular, node.acceleration, node.angular_acceleration)
+    new_speed = np.empty(len(piece), dtype=bool)
+    new_speed[0] = _changed_value(last, "linear_speed", (float(speeds[0]), *rest))
+    new_speed[1:] = speeds[1:] != speeds[:-1]
+    last["linear_speed"] = (float(speeds[-1]), *rest)
+    return new_tool, new_frame, new_speed, new_zone
 
 
 OPAQUE_KINDS = frozenset({"call", "verbatim"})
