@@ -61,7 +61,7 @@ from olp.frontends.krl.flow import (
     to_expr,
 )
 from olp.frontends.krl.module_data import with_module_data
-from olp.frontends.krl.motion import Motions
+from olp.frontends.krl.motion import _BASE_MOTION, Motions
 from olp.frontends.krl.routines import PendingCall, assemble, moves
 from olp.frontends.krl.rows import build_instructions
 from olp.frontends.krl.state import (
@@ -222,10 +222,14 @@ class _Lowering(Motions, Events):
             return
         if self.ambiguous and isinstance(stmt, MotionStmt | FastMotion):
             motion = materialise(stmt) if isinstance(stmt, FastMotion) else stmt
+            used = [why for name, why in self.ambiguous.items() if _uses_setting(motion, name)]
+        else:
+            used = []
+        if used:
             if self._controller_settings_motion(motion):
                 self.ctx.spend(stmt)
                 return
-            reasons = "; ".join(sorted(set(self.ambiguous.values())))
+            reasons = "; ".join(sorted(set(used)))
             raise self._error(
                 f"olp cannot tell which motion settings this motion runs with: {reasons}",
                 stmt.span,
@@ -864,6 +868,23 @@ _SETTING_NAMES = {
     "ori_type": "$ORI_TYPE",
     "circ_type": "$CIRC_TYPE",
 }
+
+
+def _uses_setting(motion: MotionStmt, name: str) -> bool:
+    """Whether ``motion`` runs with motion setting ``name`` (a field of :class:`State`).
+
+    ``$APO.CDIS`` is the distance of a ``C_DIS`` approximation (KSS 8 "Approximate
+    positioning": the motion's approximation parameter names which ``$APO`` component
+    applies; without one the motion is an exact stop), and ``$CIRC_TYPE`` applies to circular
+    motions only. A motion without approximation, or not a CIRC, may run where the paths that
+    reach it disagree on that setting (a loop that writes ``$APO.CDIS`` before its C_DIS
+    motion, as the KRL post does): the setting stays ambiguous for the next motion that
+    uses it. Every other setting is taken as used by every motion."""
+    if name == "cdis_mm":
+        return bool(motion.approx)
+    if name == "circ_type":
+        return _BASE_MOTION.get(motion.keyword) == "CIRC"
+    return True
 
 
 # ------------------------------------------------------------------------------------------------

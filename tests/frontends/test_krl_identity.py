@@ -1,0 +1,125 @@
+"""KRL -> KRL keeps every statement (issue 15): a program the KUKA post writes reads again to
+the same statements, in the same order, as its source gave.
+
+Each program here is olp's own, in the style of the KR C4 backups where the gaps were found:
+a module with parameters that other modules call, nested FOR loops with jumps and motion
+settings, and signal names from ``$config.dat``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import olp
+from olp.errors import ParseError
+from olp.frontends.bundled import KrlOptions
+from olp.frontends.krl import load_krl
+from olp.ir_flow import leaves_and_blocks
+
+REPO = Path(__file__).resolve().parents[2]
+STATION = REPO / "stations" / "kr6_milling_cell.yaml"
+
+
+@pytest.fixture(scope="module")
+def station() -> object:
+    return olp.load_station(STATION)
+
+
+def shape(program: object) -> list[str]:
+    """Statements and blocks in order, declarations apart: kind, or the text of a kept line."""
+    out = []
+    for node in leaves_and_blocks(program.instructions):  # type: ignore[attr-defined]
+        if node.kind == "verbatim":
+            out.append(node.text.upper().replace(" ", ""))
+        elif node.kind != "declare":
+            out.append(node.kind)
+    return out
+
+
+def build(station: object, tmp_path: Path, text: str, name: str = "cell.src", **options: object):  # type: ignore[no-untyped-def]
+    source = tmp_path / "in" / name
+    source.parent.mkdir(exist_ok=True)
+    source.write_text(text)
+    krl = KrlOptions(**options)  # type: ignore[arg-type]
+    return olp.build(station, source, post="kuka", program_options=krl, collisions=None)
+
+
+def read_again(result: object, tmp_path: Path, **options: object) -> object:
+    """The written ``.src`` (and ``.dat``) read again by the KRL frontend."""
+    out = tmp_path / "out"
+    out.mkdir(exist_ok=True)
+    for name, text in result.files.items():  # type: ignore[attr-defined]
+        (out / name).write_text(text)
+    (src,) = [n for n in result.files if n.lower().endswith(".src")]  # type: ignore[attr-defined]
+    return load_krl(out / src, **options).program  # type: ignore[arg-type]
+
+
+# --------------------------------------------------------------------------------------------
+# Nested FOR loops, a jump back into the inner one, $APO.CDIS written inside the loop
+
+STACKER = """DEF stacker( )
+DECL INT nRow
+DECL INT nCol
+DECL INT iAx
+DECL E6POS pDrop
+$VEL.CP = 0.5
+$APO.CDIS = 20
+$TOOL = {X 0, Y 0, Z 120, A 0, B 0, C 0}
+$BASE = {X 500, Y 0, Z 300, A 0, B 0, C 0}
+PTP {A1 0, A2 -90, A3 90, A4 0, A5 45, A6 0}
+FOR nRow = 1 TO 2
+  FOR nCol = 1 TO 3
+    retry:
+    pDrop = {X 100, Y -100, Z 100, A 0, B 90, C 0}
+    pDrop.Y = pDrop.Y + 40 * nCol
+    FOR iAx = 1 TO 6
+      $VEL_AXIS[iAx] = 40
+    ENDFOR
+    PTP pDrop
+    LIN {X 120, Y -60, Z 80, A 0, B 90, C 0} C_DIS
+    LIN {X 120, Y -60, Z 40, A 0, B 90, C 0}
+    IF $IN[4] THEN
+      GOTO retry
+    ENDIF
+  ENDFOR
+ENDFOR
+END
+"""
+
+
+def test_nested_loops_with_a_jump_back_read_again_the_same(station: object, tmp_path: Path) -> None:
+    """The post writes ``$APO.CDIS`` inside the loop, before the C_DIS motion that uses it; read
+    again, the exact-stop PTP before it does not depend on it (it stopped the reading with
+    "$APO.CDIS differs between the paths of the FOR")."""
+    result = build(station, tmp_path, STACKER)
+    assert result.ok, [d.format() for d in result.diagnostics if d.severity == "error"]
+    again = read_again(result, tmp_path)
+    assert shape(again) == shape(result.compiled.program)  # type: ignore[attr-defined]
+
+
+BRANCHED_CDIS = """DEF cell( )
+$VEL.CP = 0.5
+$TOOL = {X 0, Y 0, Z 120, A 0, B 0, C 0}
+$BASE = {X 500, Y 0, Z 300, A 0, B 0, C 0}
+PTP {A1 0, A2 -90, A3 90, A4 0, A5 45, A6 0}
+IF $IN[2] THEN
+  $APO.CDIS = 5
+ELSE
+  $APO.CDIS = 10
+ENDIF
+LIN {X 100, Y -100, Z 100, A 0, B 90, C 0}
+LIN {X 120, Y -60, Z 80, A 0, B 90, C 0} C_DIS
+END
+"""
+
+
+def test_a_c_dis_motion_still_needs_a_known_distance(tmp_path: Path) -> None:
+    """Paths that disagree on ``$APO.CDIS``: the exact stop after them runs, the next motion
+    that approximates with it stops the reading at its line."""
+    path = tmp_path / "cell.src"
+    path.write_text(BRANCHED_CDIS)
+    with pytest.raises(ParseError, match=r"\$APO.CDIS differs between the paths") as info:
+        load_krl(path)
+    assert info.value.span is not None and info.value.span.line == 12
