@@ -826,18 +826,34 @@ class Program:
     give count every move of a toolpath as one instruction, as if the program held ordinary
     moves only; they walk the program's own body (a call is one instruction), while
     :meth:`expanded` walks into each call.
+
+    ``params``: the program's own parameters in call order (:class:`Parameter`, as a
+    routine's), for a program that other programs call with arguments (a KRL module
+    ``DEF MoveSettings(nBase:IN, nTool:IN)``). Their values are known only when the program
+    runs: what its body computes from them is run-time. A post writes them where its language
+    lets a program take arguments and refuses the program with a located error otherwise.
     """
 
     name: str
     instructions: tuple[Node, ...]
     source: str = "<memory>"
     routines: tuple[Routine, ...] = ()
+    params: tuple[Parameter, ...] = ()
 
     def __post_init__(self) -> None:
         if not isinstance(self.instructions, tuple):
             object.__setattr__(self, "instructions", tuple(self.instructions))
         if not isinstance(self.routines, tuple):
             object.__setattr__(self, "routines", tuple(self.routines))
+        if not isinstance(self.params, tuple):
+            object.__setattr__(self, "params", tuple(self.params))
+        names: set[str] = set()
+        for param in self.params:
+            if not isinstance(param, Parameter):
+                raise IRError(f"Program.params must hold Parameter objects, got {param!r}")
+            if param.name.casefold() in names:
+                raise IRError(f"Program {self.name}: parameter {param.name} is given twice")
+            names.add(param.name.casefold())
         seen: set[str] = set()
         for routine in self.routines:
             if not isinstance(routine, Routine):
@@ -876,8 +892,9 @@ class Program:
     @property
     def has_flow(self) -> bool:
         """Whether the program holds control flow or data statements (:mod:`olp.ir_flow`),
-        routines included."""
-        return bool(self.routines) or _flow.has_flow(self.instructions)
+        routines and parameters included (a program with parameters is never split into
+        parts: a part would not see them)."""
+        return bool(self.routines or self.params) or _flow.has_flow(self.instructions)
 
     def flat_nodes(self) -> tuple[Instruction | LinearPath, ...]:
         """The nodes in source order with blocks walked into: what the passes check, one step

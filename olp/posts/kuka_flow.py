@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Sequence
 from typing import Any
 
 from olp import ir
@@ -114,6 +115,17 @@ def krl_routine_head(routine: ir.Routine) -> str:
         f"[{','.join(krl_expr(d) for d in routine.returns_dims)}]" if routine.returns_dims else ""
     )
     return f"{prefix}DEFFCT {routine.returns}{dims} {routine.name}({params})"
+
+
+def krl_program_head(name: str, params: Sequence[ir.Parameter]) -> str:
+    """The program's ``DEF``: ``DEF name( )`` as the pendant writes a program without
+    parameters, ``DEF name(p:IN, q:OUT)`` for one that other modules call with arguments
+    (:attr:`olp.ir.Program.params`, written as a routine's, :func:`krl_routine_head`; their
+    types are declared first in the body, :func:`krl_param_decl`). The module's first DEF is
+    the one other modules call by the module's name, so it needs no ``GLOBAL``."""
+    if not params:
+        return f"DEF {name}( )"
+    return krl_routine_head(ir.Routine(name=name, params=tuple(params)))
 
 
 def _empty_index(dims: tuple[object, ...]) -> str:

@@ -123,3 +123,97 @@ def test_a_c_dis_motion_still_needs_a_known_distance(tmp_path: Path) -> None:
     with pytest.raises(ParseError, match=r"\$APO.CDIS differs between the paths") as info:
         load_krl(path)
     assert info.value.span is not None and info.value.span.line == 12
+
+
+# --------------------------------------------------------------------------------------------
+# A program with parameters of its own: a module other modules call
+
+GRIP_MODULE = """&ACCESS RVP
+DEF SetGrip(nSlot:IN, bClose:IN, rWait:IN, nResult:OUT)
+DECL INT nSlot
+DECL BOOL bClose
+DECL REAL rWait
+DECL INT nResult
+DECL INT nTry
+nTry = 0
+IF bClose THEN
+  $OUT[nSlot] = TRUE
+ELSE
+  $OUT[nSlot] = FALSE
+ENDIF
+WAIT SEC 0.2
+nResult = nSlot * 10 + nTry
+END
+"""
+
+
+def test_the_programs_parameters_are_in_the_ir(tmp_path: Path) -> None:
+    path = tmp_path / "SetGrip.src"
+    path.write_text(GRIP_MODULE)
+    program = load_krl(path).program
+    params = [(p.name, p.type_name, p.direction, p.span.line) for p in program.params]
+    assert params == [
+        ("nSlot", "INT", "in", 3),
+        ("bClose", "BOOL", "in", 4),
+        ("rWait", "REAL", "in", 5),
+        ("nResult", "INT", "out", 6),
+    ]
+    declared = [n.name for n in program.instructions if n.kind == "declare"]
+    assert declared == ["nTry"]  # the parameters' DECL lines type them, not locals
+
+
+def test_the_krl_post_writes_the_programs_parameters(station: object, tmp_path: Path) -> None:
+    result = build(station, tmp_path, GRIP_MODULE, "SetGrip.src")
+    assert result.ok, [d.format() for d in result.diagnostics if d.severity == "error"]
+    assert not [d for d in result.diagnostics if "parameters" in d.message]
+    lines = result.files["SetGrip.src"].splitlines()
+    assert lines[2] == "DEF SetGrip(nSlot:IN, bClose:IN, rWait:IN, nResult:OUT)"
+    assert lines[4:9] == [
+        "DECL INT nSlot",
+        "DECL BOOL bClose",
+        "DECL REAL rWait",
+        "DECL INT nResult",
+        "DECL INT nTry",
+    ]
+    again = read_again(result, tmp_path)
+    written = [(p.name, p.type_name, p.direction) for p in again.params]  # type: ignore[attr-defined]
+    assert written == [
+        ("nSlot", "INT", "in"),
+        ("bClose", "BOOL", "in"),
+        ("rWait", "REAL", "in"),
+        ("nResult", "INT", "out"),
+    ]
+    assert shape(again) == shape(result.compiled.program)  # type: ignore[attr-defined]
+
+
+@pytest.mark.parametrize("post", ["abb", "ur", "fanuc"])
+def test_other_posts_refuse_a_program_with_parameters(
+    station: object, tmp_path: Path, post: str
+) -> None:
+    """RAPID, URScript and LS programs are entry points started without arguments (see each
+    post's ``PROGRAM_PARAMS``): a located error naming the parameters, nothing written."""
+    source = tmp_path / "SetGrip.src"
+    source.write_text(GRIP_MODULE)
+    result = olp.build(station, source, post=post, collisions=None)  # type: ignore[arg-type]
+    (error,) = [d for d in result.diagnostics if d.kind == "program_params"]
+    assert error.severity == "error" and not result.files
+    assert error.span is not None and (error.span.file, error.span.line) == (str(source), 3)
+    assert "(nSlot, bClose, rWait, nResult)" in error.message
+
+
+def test_a_copied_kuka_folder_without_the_flag_refuses_them(
+    station: object, tmp_path: Path
+) -> None:
+    """A template folder copied before olp wrote program parameters would write ``DEF
+    SetGrip( )``: without ``program_params: true`` the post refuses the program."""
+    import shutil
+
+    folder = tmp_path / "my_kuka"
+    shutil.copytree(REPO / "posts" / "kuka", folder)
+    manifest = folder / "post.yaml"
+    manifest.write_text(manifest.read_text().replace("\nprogram_params: true", ""))
+    source = tmp_path / "SetGrip.src"
+    source.write_text(GRIP_MODULE)
+    result = olp.build(station, source, post=str(folder), collisions=None)  # type: ignore[arg-type]
+    (error,) = [d for d in result.diagnostics if d.kind == "program_params"]
+    assert "program_params: true" in error.message and not result.files

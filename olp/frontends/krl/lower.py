@@ -62,7 +62,7 @@ from olp.frontends.krl.flow import (
 )
 from olp.frontends.krl.module_data import with_module_data
 from olp.frontends.krl.motion import _BASE_MOTION, Motions
-from olp.frontends.krl.routines import PendingCall, assemble, moves
+from olp.frontends.krl.routines import PendingCall, assemble, moves, typed_params
 from olp.frontends.krl.rows import build_instructions
 from olp.frontends.krl.state import (
     DEFAULT_VEL_CP,
@@ -921,14 +921,21 @@ def lower_module(
     body = build_instructions(lowering.out)
     assembled = assemble(body, alone, {k: v for k, v in table.items() if v is not main}, sources)
     ignored = sorted(
-        [*lowering.ignored, *assembled.ignored, *_program_parameters(main, sources)],
-        key=lambda i: (i.span.line, i.span.column),
+        [*lowering.ignored, *assembled.ignored], key=lambda i: (i.span.line, i.span.column)
     )
     for data_list in (dat, config):
         ignored.extend(data_list.ignored if data_list is not None else ())
     name = main.name if main is not None else _module_name(src, routines)
+    params: tuple[ir.Parameter, ...] = ()
+    instructions = list(assembled.instructions)
+    if main is not None:
+        params, instructions = typed_params(main, instructions)
     program = ir.Program(
-        name=name, instructions=assembled.instructions, source=src, routines=assembled.routines
+        name=name,
+        instructions=tuple(instructions),
+        source=src,
+        routines=assembled.routines,
+        params=params,
     )
     program = with_module_data(program, dat, config, shared)
     return KrlResult(
@@ -940,28 +947,14 @@ def lower_module(
     )
 
 
-def _program_parameters(main: Routine | None, sources: SourceSet) -> list[IgnoredLine]:
-    """The program's own parameters (``DEF MoveTo(nBase:IN, nTool:IN)``, a module other modules
-    call) are not in the IR's program, which takes none: the written ``DEF`` has empty
-    parentheses and their ``DECL`` lines declare local variables, so a caller's arguments would
-    not reach it. Said at the ``DEF`` line, as a statement not in the output."""
-    if main is None or not main.params:
-        return []
-    names = ", ".join(p.name for p in main.params)
-    span = dataclasses.replace(main.span, end_line=main.span.line, end_column=None)
-    reason = (
-        f"the program's parameters ({names}) are not kept: the written DEF takes none and "
-        "declares them as local variables, so a caller's arguments would not reach it"
-    )
-    return [IgnoredLine(span, sources.snippet(span), reason)]
-
-
 def _variables(values: Any, ctx: Context, main: Routine | None) -> Variables:
     variables = Variables(values, ctx.unknown_name)
     params = () if main is None else main.params
     variables.push(
         {
-            p.name.upper(): Unknown(f"{p.name} is a parameter of the program; olp does not know it")
+            p.name.upper(): Unknown(
+                f"{p.name} is a parameter of the program: a caller gives it when it runs"
+            )
             for p in params
         }
     )
