@@ -597,20 +597,34 @@ class Wait:
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class SetOutput:
-    """Set digital output ``index`` to ``value``."""
+    """Set digital output ``index`` to ``value``.
+
+    ``signal``: the name the program reads the bit by where it has one (a KRL
+    ``SIGNAL OutCinta $OUT[9]`` declared outside the program, in ``$config.dat``), so that
+    a post of that language writes the program as it was written; None: by number. The name
+    is only another spelling of ``index``: every other post, and every check, uses the number.
+    """
 
     index: int
     value: bool
+    signal: str | None = None
     span: SourceSpan = GENERATED
     kind: Literal["set_output"] = field(default="set_output", init=False)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class WaitInput:
-    """Wait until digital input ``index`` equals ``value``."""
+    """Wait until digital input ``index`` equals ``value``.
+
+    ``signal``: the name the program reads the bit by where it has one (a KRL
+    ``SIGNAL InTermicoCinta $IN[9]`` declared outside the program, in ``$config.dat``), so that
+    a post of that language writes the program as it was written; None: by number. The name
+    is only another spelling of ``index``: every other post, and every check, uses the number.
+    """
 
     index: int
     value: bool = True
+    signal: str | None = None
     span: SourceSpan = GENERATED
     kind: Literal["wait_input"] = field(default="wait_input", init=False)
 

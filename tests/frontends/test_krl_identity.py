@@ -217,3 +217,65 @@ def test_a_copied_kuka_folder_without_the_flag_refuses_them(
     result = olp.build(station, source, post=str(folder), collisions=None)  # type: ignore[arg-type]
     (error,) = [d for d in result.diagnostics if d.kind == "program_params"]
     assert "program_params: true" in error.message and not result.files
+
+
+# --------------------------------------------------------------------------------------------
+# Signal names from $config.dat
+
+CONFIG = """DEFDAT $CONFIG
+SIGNAL InCintaLlena $IN[5]
+SIGNAL InPinza $IN[6]
+SIGNAL OutVacio $OUT[2]
+ENDDAT
+"""
+
+CONVEYOR = """DEF conveyor( )
+SIGNAL sLocal $IN[7]
+$VEL.CP = 0.5
+$TOOL = {X 0, Y 0, Z 120, A 0, B 0, C 0}
+$BASE = {X 500, Y 0, Z 300, A 0, B 0, C 0}
+PTP {A1 0, A2 -90, A3 90, A4 0, A5 45, A6 0}
+WAIT FOR InPinza
+IF InCintaLlena AND NOT sLocal THEN
+  OutVacio = TRUE
+  LIN {X 100, Y -100, Z 100, A 0, B 90, C 0}
+ENDIF
+WAIT FOR NOT sLocal
+OutVacio = FALSE
+$OUT[3] = TRUE
+END
+"""
+
+
+def _conveyor(station: object, tmp_path: Path, post: str = "kuka") -> object:
+    config = tmp_path / "$config.dat"
+    config.write_text(CONFIG)
+    source = tmp_path / "conveyor.src"
+    source.write_text(CONVEYOR)
+    options = KrlOptions(config_dat=config)
+    return olp.build(station, source, post=post, program_options=options, collisions=None)
+
+
+def test_the_krl_post_writes_signal_names_where_the_source_used_them(
+    station: object, tmp_path: Path
+) -> None:
+    """Names declared in ``$config.dat`` are written as the user wrote them; a SIGNAL of the
+    module itself (not written back) and a bit read by number are written by number."""
+    result = _conveyor(station, tmp_path)
+    assert result.ok, [d.format() for d in result.diagnostics if d.severity == "error"]  # type: ignore[attr-defined]
+    lines = result.files["conveyor.src"].splitlines()  # type: ignore[attr-defined]
+    assert "WAIT FOR InPinza" in lines
+    assert "IF InCintaLlena AND NOT $IN[7] THEN" in lines
+    assert lines.count("OutVacio = TRUE") == lines.count("OutVacio = FALSE") == 1
+    assert "WAIT FOR NOT $IN[7]" in lines and "$OUT[3] = TRUE" in lines
+    again = read_again(result, tmp_path, config_dat=tmp_path / "$config.dat")
+    assert shape(again) == shape(result.compiled.program)  # type: ignore[attr-defined]
+
+
+@pytest.mark.parametrize(("post", "written"), [("abb", "di5"), ("ur", "get_digital_in(5)")])
+def test_other_posts_write_the_signals_by_number(
+    station: object, tmp_path: Path, post: str, written: str
+) -> None:
+    result = _conveyor(station, tmp_path, post)
+    text = "".join(result.files.values())  # type: ignore[attr-defined]
+    assert written in text and "InCintaLlena" not in text and "OutVacio" not in text

@@ -326,7 +326,7 @@ class _Lowering(Motions, Events):
         (:class:`olp.ir.Declare`, one per name)."""
         self.data.declare(stmt, self.variables.declare, local=True)
         for item in stmt.items:
-            dims = tuple(to_expr(d, self._input_index) for d in item.dims or ())
+            dims = tuple(to_expr(d, self._input_of) for d in item.dims or ())
             value = None if item.value is None else self._expr(item.value)
             self.out.append(
                 ir.Declare(
@@ -396,7 +396,7 @@ class _Lowering(Motions, Events):
             self.returned, self.exiting, self.loop_depth, self.loops, self.routine = saved[:5]
             self.jumped, self.return_ends = saved[5], saved_ends
         self._write_back(routine, stmt, bound, finals)
-        args = tuple(to_expr(arg, self._input_index) for arg in stmt.args)
+        args = tuple(to_expr(arg, self._input_of) for arg in stmt.args)
         call = ir.RoutineCall(name=routine.name, args=args, span=stmt.span)
         body = build_instructions(lowered)
         generic = self._generic_body(routine, stmt) if self._reads_params(routine) else None
@@ -504,26 +504,27 @@ class _Lowering(Motions, Events):
             condition = self._expr(stmt.condition)
             self.out.append(ir.WaitUntil(condition=condition, span=stmt.span))
             return
-        index, value = found
-        self.out.append(ir.WaitInput(index=index, value=value, span=stmt.span))
+        index, value, signal = found
+        self.out.append(ir.WaitInput(index=index, value=value, signal=signal, span=stmt.span))
 
-    def _input_condition(self, expr: Expr) -> tuple[int, bool] | None:
-        """``$IN[n]``, ``NOT $IN[n]``, ``$IN[n] == TRUE``, ``$IN[n] <> FALSE`` -> (n, value);
-        a one-bit SIGNAL of an input stands for its ``$IN[n]``."""
+    def _input_condition(self, expr: Expr) -> tuple[int, bool, str | None] | None:
+        """``$IN[n]``, ``NOT $IN[n]``, ``$IN[n] == TRUE``, ``$IN[n] <> FALSE`` -> (n, value,
+        None); a one-bit SIGNAL of an input stands for its ``$IN[n]``, with its name where
+        the written program can use it (:meth:`_signal_name`)."""
         if isinstance(expr, Var) and expr.key == "$IN[]":
-            return self._single_index(expr, "$IN"), True
+            return self._single_index(expr, "$IN"), True, None
         if isinstance(expr, Var) and not expr.selectors:
             signal = self._value(expr)
             if isinstance(signal, Signal) and signal.io == "$IN":
-                return signal.index, True
+                return signal.index, True, self._signal_name(expr, signal)
         if isinstance(expr, Unary) and expr.op == "NOT":
             inner = self._input_condition(expr.operand)
-            return None if inner is None else (inner[0], not inner[1])
+            return None if inner is None else (inner[0], not inner[1], inner[2])
         if isinstance(expr, Binary) and expr.op in ("==", "<>"):
             for var, other in ((expr.left, expr.right), (expr.right, expr.left)):
                 inner, value = self._input_condition(var), self._value(other)
                 if inner is not None and isinstance(value, Bool):
-                    return inner[0], (inner[1] == value.value) == (expr.op == "==")
+                    return inner[0], (inner[1] == value.value) == (expr.op == "=="), inner[2]
         return None
 
     # ---- loops and other control flow
@@ -752,7 +753,7 @@ class _Lowering(Motions, Events):
             self.track = dataclasses.replace(tracks[0])
 
     def _expr(self, expr: Expr) -> ir.Expr:
-        converted = to_expr(expr, self._input_index)
+        converted = to_expr(expr, self._input_of)
         assert converted is not None
         return converted
 
