@@ -137,7 +137,8 @@ def account(text: str, src: str, result: object, tally: Tally) -> None:
 
     program = result.compiled.program  # type: ignore[attr-defined]
     lines = statement_lines(text)
-    kept = {n.span.line for n in leaves_and_blocks(program.instructions) if n.span.file == src}
+    nodes = [*program.params, *leaves_and_blocks(program.instructions)]
+    kept = {n.span.line for n in nodes if n.span.file == src}
     nodes = list(leaves_and_blocks(program.instructions))
     motions = [n.span.line for n in nodes if is_motion(n) and n.span.file == src]
     for routine in program.routines:  # the module's routines the program keeps, written out too

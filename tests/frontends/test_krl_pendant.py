@@ -582,10 +582,10 @@ def test_signals_from_config(config: KrlData) -> None:
     result = parse(
         "GRIPPER_CLOSE = TRUE", "WAIT FOR PART_GRIPPED", "WAIT FOR NOT PART_GRIPPED", config=config
     )
-    assert plain(result) == [
-        ir.SetOutput(index=17, value=True),
-        ir.WaitInput(index=5, value=True),
-        ir.WaitInput(index=5, value=False),
+    assert plain(result) == [  # by number, with the name the program used (issue 15)
+        ir.SetOutput(index=17, value=True, signal="GRIPPER_CLOSE"),
+        ir.WaitInput(index=5, value=True, signal="PART_GRIPPED"),
+        ir.WaitInput(index=5, value=False, signal="PART_GRIPPED"),
     ]
 
 

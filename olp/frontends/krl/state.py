@@ -281,6 +281,7 @@ class Context:
         self.budget = self.remaining = budget
         self.config = config
         self.module_dat = dat
+        self.src = src
         self.shared = tuple(shared)
         self._where = self._describe_files(src)
         # > 0 while a FOR body is tried with its counter unknown: a motion to a run-time
@@ -414,23 +415,36 @@ class Core:
         from olp.frontends.krl.flow import to_expr
 
         target = to_expr(stmt.target, lambda _: None)
-        value = to_expr(stmt.value, self._input_index)
+        value = to_expr(stmt.value, self._input_of)
         assert target is not None and value is not None
         return ir.Assign(target=target, value=value, span=stmt.span)
 
-    def _input_index(self, var: Var) -> int | None:
-        """The input number of ``$IN[n]`` (a constant ``n``) or of a one-bit SIGNAL of an
-        input: read as :class:`~olp.ir.DigitalInput` wherever an expression is."""
+    def _input_of(self, var: Var) -> ir.DigitalInput | None:
+        """``$IN[n]`` (a constant ``n``) or a one-bit SIGNAL of an input as the
+        :class:`~olp.ir.DigitalInput` it reads, wherever an expression is (with the signal's
+        name where :meth:`_signal_name` keeps it)."""
         if var.key == "$IN[]":
             index = var.selectors[0]
             assert isinstance(index, Index)
             arg = index.args[0] if len(index.args) == 1 else None
-            return None if arg is None else as_int(self._value(arg))
+            number = None if arg is None else as_int(self._value(arg))
+            return None if number is None else ir.DigitalInput(index=number, span=var.span)
         if not var.selectors:
             signal = self._value(var)
             if isinstance(signal, Signal) and signal.io == "$IN":
-                return signal.index
+                name = self._signal_name(var, signal)
+                return ir.DigitalInput(index=signal.index, signal=name, span=var.span)
         return None
+
+    def _signal_name(self, var: Var, signal: Signal) -> str | None:
+        """The name ``var`` reads ``signal`` by, where the written program can use it too: a
+        SIGNAL declared outside the module (``$config.dat``, another module's data list),
+        which the controller declares for the written program as for its source. One in the
+        module's own ``.src`` or ``.dat`` is not written back, so the post writes the number
+        there (None)."""
+        dat = self.ctx.module_dat
+        own = {self.ctx.src, *(() if dat is None else (dat.filename,))}
+        return None if signal.span.file in own else var.name
 
     def _keep(self, stmt: Stmt | Assign, reason: str) -> None:
         """Keep a statement olp does not model as :class:`~olp.ir.Verbatim` (its text without
@@ -654,12 +668,14 @@ class Core:
                 return
         self._output(self._single_index(stmt.target, "$OUT"), value, stmt)
 
-    def _output(self, index: int, value: Expr, stmt: Assign) -> None:
+    def _output(self, index: int, value: Expr, stmt: Assign, signal: str | None = None) -> None:
         constant = self._value(value)
         if not isinstance(constant, Bool):
             self._keep(stmt, "an output set to a value olp does not know (not TRUE or FALSE)")
             return
-        self.out.append(ir.SetOutput(index=index, value=constant.value, span=stmt.span))
+        self.out.append(
+            ir.SetOutput(index=index, value=constant.value, signal=signal, span=stmt.span)
+        )
 
     def _is_signal(self, target: Var) -> bool:
         return not target.selectors and isinstance(self._value(target), Signal)
@@ -670,7 +686,7 @@ class Core:
         if signal.io != "$OUT":
             self._ignore(stmt, f"{stmt.target.name} is an input ({signal.io}) and cannot be set")
             return
-        self._output(signal.index, stmt.value, stmt)
+        self._output(signal.index, stmt.value, stmt, self._signal_name(stmt.target, signal))
 
     def _set_home(self, name: str, value: Expr, stmt: Stmt) -> None:
         """``$H_POS = XHOME``: olp learns the home position (for ``PTP $H_POS``) and keeps the
