@@ -112,6 +112,18 @@ def krl_declaration(step: Any) -> bool:
     )
 
 
+def krl_declarations(steps: Any) -> list[str]:
+    """The texts of the kept declaration lines among ``steps`` (:func:`krl_declaration`), each
+    once (a routine written out at each of its calls brings its EXT lines each time), in
+    order."""
+    texts: dict[str, str] = {}
+    for step in steps:
+        if krl_declaration(step):
+            text = step.instruction.text
+            texts.setdefault(re.sub(r"\s+", "", text).upper(), text)
+    return list(texts.values())
+
+
 def krl_routine_head(routine: ir.Routine) -> str:
     """``[GLOBAL] DEF name(p:IN, q:OUT)`` or ``[GLOBAL] DEFFCT TYPE[dims] name(...)``: an
     ``"in"`` parameter is KRL's ``:IN`` (by value), an ``"out"`` one ``:OUT`` (by reference);

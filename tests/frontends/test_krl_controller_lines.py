@@ -159,6 +159,21 @@ def test_an_ext_declaration_is_written_with_the_declarations(
     assert ext < lines.index("BAS (#INITMOV,0 )") < lines.index("nCycle = 0")
 
 
+def test_an_ext_of_a_routine_written_at_each_call_is_declared_once(
+    station: object, tmp_path: Path
+) -> None:
+    """A routine whose motion depends on its parameter is written out at each call: its EXT
+    comes with it each time, and KRL wants a name declared once."""
+    text = (
+        f"DEF cell( )\n{HOME}\nfeed(10)\nfeed(20)\nEND\n\nDEF feed(nA :IN)\nDECL INT nA\n"
+        f"DECL E6AXIS aAt\nEXT belt_start( )\naAt = {HOME[4:]}\naAt.A1 = nA\nPTP aAt\n"
+        "belt_start()\nEND\n"
+    )
+    lines = written_lines(build(station, tmp_path, text))
+    assert lines.count("EXT belt_start( )") == 1 and lines.count("belt_start()") == 2
+    assert lines.index("EXT belt_start( )") < lines.index("BAS (#INITMOV,0 )")
+
+
 def test_another_post_says_what_it_leaves_of_an_ext(station: object, tmp_path: Path) -> None:
     result = build(station, tmp_path, EXT, "abb")
     assert said_at(result, 3) and said_at(result, 4)
