@@ -218,3 +218,9 @@ def test_a_label_a_goto_targets_ends_the_dead_code() -> None:
         ("$OUT[1] = TRUE", 7)
     ]
     assert [m.span.line for m in program.motions()] == [2, 9]
+
+
+def test_the_program_override_is_kept_and_its_timing_noted() -> None:
+    result = parse_krl(f"DEF slow( )\n$OV_PRO = 30\n{HOME}\nEND\n", "slow.src")
+    assert [(n.kind, n.span.line) for n in result.program] == [("verbatim", 2), ("joint", 3)]
+    assert [(n.span.line, "100 %" in n.message) for n in result.notes] == [(2, True)]

@@ -229,6 +229,12 @@ KRL_ONLY_SYSTEM_VARIABLES = frozenset({"$LOAD", "$GEAR_JERK[]", "$COLLMON_TOL_PR
 limits, collision-detection tolerances): kept for the KRL post (also from a spline WITH, where
 the pendant's motion folds set them), left out by other posts with a warning
 (:meth:`Core._keep_krl_only`)."""
+TIMING_NOTES = {
+    "$OV_PRO": "the program override ($OV_PRO) scales the speed of every motion after it: "
+    "olp does not model it, so its cycle time is the program's at 100 %",
+}
+"""What a kept system variable does to olp's figures, said once per program (keys as
+:attr:`Var.key`)."""
 INPUT_ASSIGNMENT = "is an input ({io}) and cannot be set"
 """Why an assignment to an input is left out (with a warning): the controller sets inputs.
 Whether the KRL compiler refuses it is not verified, so olp does not stop on it."""
@@ -559,8 +565,10 @@ class Core:
         elif key.startswith("$"):
             # a timer, a flag, a message text, torque monitoring: it changes what the program
             # does on the controller, so it is written back, never left out
-            name = key.split("[")[0].removesuffix("[]")
+            name = key.split("[")[0]
             self._keep(stmt, f"system variable {name} is not modelled: kept as written")
+            if key in TIMING_NOTES:
+                self._note(stmt.span, TIMING_NOTES[key], once=key)
         elif self._is_signal(stmt.target):
             self._signal_output(stmt)
         else:
