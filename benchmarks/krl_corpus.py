@@ -283,7 +283,7 @@ def _kind(line: str) -> str:
     word = _WORD.match(line.strip())
     first = word.group(0).upper() if word else line[:12]
     rest = line.strip()[len(first) :].lstrip()
-    if first in _KEYWORDS or first.startswith("$") or first.endswith("_ACT"):
+    if first in _KEYWORDS or _STRUCTURE.match(first) or first.startswith("$") or "_ACT" in first:
         return first
     return "call" if rest.startswith("(") else "assignment"
 
