@@ -99,6 +99,33 @@ def krl_decl(step: Any) -> str:
     return SafeText("\n".join(lines))
 
 
+_DECLARATION = re.compile(r"(?i)\s*(GLOBAL\s+)?(EXT|EXTFCT)\s")
+
+
+def krl_declaration(step: Any) -> bool:
+    """Whether ``step`` is a kept KRL line that declares (``EXT name( )``, ``EXTFCT INT
+    f( )``): KRL takes those only in a routine's declaration part, before its first
+    statement, so the templates write them with the ``DECL`` lines, not in the flow."""
+    node = getattr(step, "instruction", step)
+    return (
+        isinstance(node, ir.Verbatim)
+        and node.language == "krl"
+        and _DECLARATION.match(node.text) is not None
+    )
+
+
+def krl_declarations(steps: Any) -> list[str]:
+    """The texts of the kept declaration lines among ``steps`` (:func:`krl_declaration`), each
+    once (a routine written out at each of its calls brings its EXT lines each time), in
+    order."""
+    texts: dict[str, str] = {}
+    for step in steps:
+        if krl_declaration(step):
+            text = step.instruction.text
+            texts.setdefault(re.sub(r"\s+", "", text).upper(), text)
+    return list(texts.values())
+
+
 def krl_routine_head(routine: ir.Routine) -> str:
     """``[GLOBAL] DEF name(p:IN, q:OUT)`` or ``[GLOBAL] DEFFCT TYPE[dims] name(...)``: an
     ``"in"`` parameter is KRL's ``:IN`` (by value), an ``"out"`` one ``:OUT`` (by reference);

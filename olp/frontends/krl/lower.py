@@ -71,6 +71,7 @@ from olp.frontends.krl.state import (
     Pending,
     PendingRows,
     State,
+    code_of,
     is_here,
 )
 from olp.frontends.krl.values import (
@@ -218,7 +219,7 @@ class _Lowering(Motions, Events):
             self._ignore(stmt, f"not reached: the EXIT at line {self.exiting} leaves the loop")
             return
         if self.jumped is not None and not (isinstance(stmt, Other) and stmt.kind == "label"):
-            self._ignore(stmt, f"not reached: the GOTO at line {self.jumped} jumps away")
+            self._keep_dead(stmt, self.jumped)
             return
         if self.ambiguous and isinstance(stmt, MotionStmt | FastMotion):
             motion = materialise(stmt) if isinstance(stmt, FastMotion) else stmt
@@ -769,6 +770,28 @@ class _Lowering(Motions, Events):
         self.out.append(ir.Goto(label=stmt.name or "", span=stmt.span))
         self.jumped = stmt.span.line
 
+    def _keep_dead(self, stmt: Stmt, goto: int) -> None:
+        """A statement no path reaches, after the GOTO at line ``goto``: kept as its source
+        lines (a block line by line, comments left out), each a :class:`~olp.ir.Verbatim`,
+        not lowered: a motion in it is neither checked nor timed, and in the output it stays
+        where the GOTO jumps over it (a label a GOTO targets ends the dead stretch: see
+        :meth:`lower_statement`)."""
+        source = self.sources.source(stmt.span.file)
+        span = stmt.span
+        reason = f"not reached: the GOTO at line {goto} jumps away"
+        self._note(
+            span,
+            f"the statements after the GOTO at line {goto} are never reached: kept as written, "
+            "not checked or timed",
+            once=f"dead-{span.file}-{goto}",
+        )
+        last = span.end_line if span.end_line is not None else span.line
+        for number in range(span.line, max(last, span.line) + 1):  # a block: to its END...
+            text = code_of((source.line(number) if source is not None else None) or "")
+            if text:
+                where = ir.SourceSpan(span.file, number, 1)
+                self._keep_text(text, where, reason, krl_only=True)
+
     def _label(self, stmt: Other) -> None:
         name = (stmt.name or "").upper()
         lines = self.routine.targets.get(name, [])
@@ -842,6 +865,8 @@ class _Lowering(Motions, Events):
             self.exiting = stmt.span.line
         elif stmt.kind == "EXIT" and self.loop_depth > 0:
             self.exiting = stmt.span.line
+        elif stmt.kind == "EXT":
+            self._keep_krl_only(stmt, OTHER_REASONS[stmt.kind])
         elif stmt.kind in _KEPT_OTHERS:
             self._keep(stmt, OTHER_REASONS[stmt.kind])
         else:

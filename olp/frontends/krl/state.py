@@ -219,16 +219,32 @@ KEPT_SYSTEM_VARIABLES = frozenset(
         "$LOAD",
         "$GEAR_JERK[]",
         "$JERK",
+        "$COLLMON_TOL_PRO[]",
     }
 )
 """Motion parameters olp does not model yet but must not lose: kept as :class:`~olp.ir.Verbatim`
 (timing does not use them; the KRL post writes them back)."""
+KRL_ONLY_SYSTEM_VARIABLES = frozenset({"$LOAD", "$GEAR_JERK[]", "$COLLMON_TOL_PRO[]"})
+"""System variables that only mean something on a KUKA controller (payload data, gear jerk
+limits, collision-detection tolerances): kept for the KRL post (also from a spline WITH, where
+the pendant's motion folds set them), left out by other posts with a warning
+(:meth:`Core._keep_krl_only`)."""
+TIMING_NOTES = {
+    "$OV_PRO": "the program override ($OV_PRO) scales the speed of every motion after it: "
+    "olp does not model it, so its cycle time is the program's at 100 %",
+}
+"""What a kept system variable does to olp's figures, said once per program (keys as
+:attr:`Var.key`)."""
+INPUT_ASSIGNMENT = "is an input ({io}) and cannot be set"
+"""Why an assignment to an input is left out (with a warning): the controller sets inputs.
+Whether the KRL compiler refuses it is not verified, so olp does not stop on it."""
 SYSTEM_REASONS = {
     **SYSTEM_REASONS,
     "$ACC.ORI1": "orientation acceleration ($ACC.ORI1) is not part of olp's IR",
     "$ACC.ORI2": "orientation acceleration ($ACC.ORI2) is not part of olp's IR",
     "$VEL.ORI1": "orientation speed ($VEL.ORI1) is not lowered",
     "$VEL.ORI2": "orientation speed ($VEL.ORI2) is not lowered",
+    "$IN[]": f"$IN {INPUT_ASSIGNMENT.format(io='$IN')}",
 }
 
 
@@ -242,6 +258,20 @@ WRITTEN = "written"
 INLINE_FORM_DATA = frozenset({"PDAT_ACT", "LDAT_ACT", "FDAT_ACT"})
 """What the pendant's inline forms assign for BAS to read: absorbed into the motions' speeds,
 zones, tools and bases (:mod:`olp.frontends.krl.inline`), not kept as assignments."""
+
+
+def code_of(line: str) -> str:
+    """``line`` without its comment (a ``;`` outside a string or character constant) and
+    surrounding blanks."""
+    quote = None
+    for index, char in enumerate(line):
+        if quote is not None:
+            quote = None if char == quote else quote
+        elif char in "\"'":
+            quote = char
+        elif char == ";":
+            return line[:index].strip()
+    return line.strip()
 
 
 def calls_function(expr: Expr) -> bool:
@@ -449,13 +479,28 @@ class Core:
     def _keep(self, stmt: Stmt | Assign, reason: str) -> None:
         """Keep a statement olp does not model as :class:`~olp.ir.Verbatim` (its text without
         the comment): the KRL post writes it back, other posts stop on it."""
-        text = self.sources.snippet(stmt.span).split(";", 1)[0].strip()
+        self._keep_text(code_of(self.sources.snippet(stmt.span)), stmt.span, reason)
+
+    def _keep_krl_only(self, stmt: Stmt | Assign, reason: str) -> None:
+        """Keep a statement that only means something on a KUKA controller (an ``EXT``
+        declaration, payload data, code a GOTO jumps over): the KRL post writes it back; to
+        another post it is harmless to leave out, with a warning giving ``reason``.
+
+        The IR's mark for that is not in this branch: until it is, this keeps a plain
+        :class:`~olp.ir.Verbatim` (other posts stop on it, as on any kept statement)."""
+        self._keep_text(code_of(self.sources.snippet(stmt.span)), stmt.span, reason, True)
+
+    def _keep_text(
+        self, text: str, span: ir.SourceSpan, reason: str, krl_only: bool = False
+    ) -> None:
+        """Keep ``text`` (one statement of the source at ``span``) as written; ``krl_only``:
+        it only means something on a KUKA controller (not marked in the IR yet)."""
         try:
-            kept = ir.Verbatim(text=text, language="krl", reason=reason, span=stmt.span)
+            kept = ir.Verbatim(text=text, language="krl", reason=reason, span=span)
         except ir.FlowError as exc:  # a control character (a lone carriage return) inside it
             raise self._error(
                 f"olp keeps this statement as written, but it is not one clean line: {exc}",
-                stmt.span,
+                span,
                 hint="remove the control character from the statement",
             ) from None
         self.out.append(kept)
@@ -528,10 +573,16 @@ class Core:
         if setter is not None:
             setter(key, stmt.value, stmt)
         elif key in KEPT_SYSTEM_VARIABLES:
-            self._keep(stmt, SYSTEM_REASONS[key])
+            self._keep_system(stmt, key)
+        elif key in SYSTEM_REASONS:  # $BWDSTART, an input ($IN[n] = ...), $CIRC_MODE
+            self._ignore(stmt, SYSTEM_REASONS[key])
         elif key.startswith("$"):
-            generic = f"system variable {key.split('[')[0]} is not lowered yet"
-            self._ignore(stmt, SYSTEM_REASONS.get(key, generic))
+            # a timer, a flag, a message text, torque monitoring: it changes what the program
+            # does on the controller, so it is written back, never left out
+            name = key.split("[")[0]
+            self._keep(stmt, f"system variable {name} is not modelled: kept as written")
+            if key in TIMING_NOTES:
+                self._note(stmt.span, TIMING_NOTES[key], once=key)
         elif self._is_signal(stmt.target):
             self._signal_output(stmt)
         else:
@@ -550,6 +601,15 @@ class Core:
                 self.absorbed_data[name] = WRITTEN
             else:
                 self.absorbed_data[name] = None if stmt.target.selectors else stmt
+
+    def _keep_system(self, stmt: Assign, key: str, why: str = "") -> None:
+        """Keep an assignment of a system variable olp does not model
+        (:data:`KEPT_SYSTEM_VARIABLES`); ``why`` is added to its reason."""
+        reason = SYSTEM_REASONS[key] + why
+        if key in KRL_ONLY_SYSTEM_VARIABLES:
+            self._keep_krl_only(stmt, reason)
+        else:
+            self._keep(stmt, reason)
 
     def _config_data_at_run_time(self, name: str, stmt: Assign) -> None:
         """``FDAT_ACT = FHOME`` (``PDEFAULT``, ``LDEFAULT``: :data:`CONFIG_DAT_DATA`) without a
@@ -684,7 +744,7 @@ class Core:
         signal = self._value(stmt.target)
         assert isinstance(signal, Signal)
         if signal.io != "$OUT":
-            self._ignore(stmt, f"{stmt.target.name} is an input ({signal.io}) and cannot be set")
+            self._ignore(stmt, f"{stmt.target.name} {INPUT_ASSIGNMENT.format(io=signal.io)}")
             return
         self._output(signal.index, stmt.value, stmt, self._signal_name(stmt.target, signal))
 
