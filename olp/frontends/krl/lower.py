@@ -161,6 +161,7 @@ class _Lowering(Motions, Events):
         self.past: set[str] = set()  # counters of unrolled FOR loops (see flow.PastFor)
         # statements that set motion settings (absorbed into the motions) since the last motion
         self.unwritten: list[Stmt] = []
+        self.unwritten_at: list[tuple[list[Any], int]] = []  # each one's output list, position
         self._blocks: dict[str, Callable[[Block], None]] = {
             "IF": self._if,
             "SWITCH": self._switch,
@@ -209,6 +210,7 @@ class _Lowering(Motions, Events):
         if isinstance(stmt, LinRows):  # checks and spends per row itself
             self._lin_rows(stmt)
             self.unwritten.clear()
+            self.unwritten_at.clear()
             return
         if self.returned is not None:
             routine, line = self.returned
@@ -222,15 +224,19 @@ class _Lowering(Motions, Events):
             return
         if self.ambiguous and isinstance(stmt, MotionStmt | FastMotion):
             motion = materialise(stmt) if isinstance(stmt, FastMotion) else stmt
-            if self._controller_settings_motion(motion):
+            unsettled = self._unsettled(motion)
+            if unsettled and self._controller_settings_motion(motion, unsettled):
                 self.ctx.spend(stmt)
                 return
-            reasons = "; ".join(sorted(set(self.ambiguous.values())))
-            raise self._error(
-                f"olp cannot tell which motion settings this motion runs with: {reasons}",
-                stmt.span,
-                hint="set them again before the motion (the pendant's inline forms do)",
-            )
+            if unsettled:
+                names = ", ".join(sorted(_SETTING_NAMES[n] for n in unsettled))
+                reasons = "; ".join(sorted(set(unsettled.values())))
+                raise self._error(
+                    f"olp cannot tell which motion settings this motion runs with ({names}): "
+                    f"{reasons}",
+                    stmt.span,
+                    hint="set them again before the motion (the pendant's inline forms do)",
+                )
         self.ctx.spend(stmt)
         past = self._past_counters(stmt)
         start, reported = len(self.out), len(self.ignored)
@@ -272,8 +278,10 @@ class _Lowering(Motions, Events):
         one that no motion follows is not in the output (:meth:`report_unwritten_settings`)."""
         if moves(new) or any(isinstance(n, Pending | PendingRows) for n in leaves(new)):
             self.unwritten.clear()
+            self.unwritten_at.clear()
         elif isinstance(stmt, Assign | CallStmt) and not new and not reported:
             self.unwritten.append(stmt)
+            self.unwritten_at.append((self.out, len(self.out)))
 
     def report_unwritten_settings(self) -> None:
         """Warn about the settings no motion of the program follows (a routine that sets
@@ -285,6 +293,7 @@ class _Lowering(Motions, Events):
                 "only before the motions that use them, so this one is not in the output",
             )
         self.unwritten.clear()
+        self.unwritten_at.clear()
 
     # ---- motions to where the robot is
     def _motion_or_here(self, stmt: MotionStmt) -> None:
@@ -670,7 +679,7 @@ class _Lowering(Motions, Events):
                 self.status_turn,
             )
             child._reported = self._reported
-            child.unwritten = self.unwritten
+            child.unwritten, child.unwritten_at = self.unwritten, self.unwritten_at
         return child
 
     def _branch(self, body: Sequence[Stmt], loop: bool = False) -> tuple[_Lowering, Body]:
