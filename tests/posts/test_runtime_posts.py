@@ -233,3 +233,40 @@ def test_other_posts_refuse_a_target_relative_to_a_run_time_start(
     assert {10, 11, 12, 13} <= refused
     messages = [m for k, line, m in errors(build(station, tmp_path, RELATIVE, post="abb"))]
     assert any("offsets from its start position in the tool frame" in m for m in messages)
+
+
+def test_krl_reads_its_relative_motions_back_the_same(station: olp.Station, tmp_path: Path) -> None:
+    from olp.frontends.krl import parse_krl
+
+    written = build(station, tmp_path, RELATIVE).files["rel.src"]
+    again = parse_krl(written, "rel.src").program
+    relative = [n.relative for n in again if isinstance(n, ir.RuntimeMove)]
+    assert relative == [None, "base", "tool", "start", "axes"]
+
+
+def test_krl_writes_a_home_fold_of_several_bas_line_for_line(
+    station: olp.Station, tmp_path: Path
+) -> None:
+    """The fold without ``$config.dat``: every line of it written, in order, the known
+    ``BAS (#VEL_PTP,80 )`` among them, and nothing between the last BAS and ``PTP XHOME``."""
+    fold = (
+        "PDAT_ACT=PDEFAULT",
+        "BAS (#PTP_DAT )",
+        "FDAT_ACT=FHOME",
+        "BAS (#FRAMES )",
+        "BAS (#VEL_PTP,80 )",
+        "PTP  XHOME",
+    )
+    lines = ("DEF path( )", *fold, *SETUP, "BAS (#VEL_PTP, 50)", "BAS (#ACC_PTP, 50)", HOME, "END")
+    result = build(station, tmp_path, lines)
+    assert result.ok, errors(result)
+    src = result.files["path.src"].splitlines()
+    start = src.index("PDAT_ACT = PDEFAULT")
+    assert src[start : start + 6] == [
+        "PDAT_ACT = PDEFAULT",
+        "BAS (#PTP_DAT )",
+        "FDAT_ACT = FHOME",
+        "BAS (#FRAMES )",
+        "BAS (#VEL_PTP,80 )",
+        "PTP XHOME",
+    ]
