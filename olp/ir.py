@@ -523,6 +523,9 @@ class CircularMove(_Motion):
 RUNTIME_MOTIONS = ("joint", "linear", "circular")
 """The motion kinds of a :class:`RuntimeMove`."""
 
+RUNTIME_RELATIVE = ("base", "tool", "axes", "start")
+"""How a :class:`RuntimeMove`'s target refers to its start position (``relative``)."""
+
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class RuntimeMove:
@@ -545,6 +548,14 @@ class RuntimeMove:
     a ``$config.dat`` olp was not given); ``speed``, ``zone``, ``tool`` and ``frame`` then mean
     nothing, a post writes none of them (only a post of that statement's language can write
     the motion), and the motion after it writes all of its own.
+    ``relative``: None, the target (and via point) is a position; else the target refers to
+    the start position, which the robot reaches only at run time (the motion before went to
+    a run-time target), as the source language means it: ``"base"`` offsets along and about
+    the base's axes from the start (KRL ``LIN_REL {Z 50}``, ``#BASE`` being the default),
+    ``"tool"`` offsets in the tool frame at the start (``LIN_REL {Z 50} #TOOL``), ``"axes"``
+    offsets added to the start's axis values (``PTP_REL {A1 10}``), ``"start"`` a position
+    whose components left out are the start's (``LIN {Z 500}``). Only a post of the source's
+    language writes such a target (its meaning is the source language's); the others refuse.
 
     Passes cannot check it (reach, limits, collisions) or time it, and the motion after it
     starts where olp does not know (:mod:`olp.passes.resolve`); a post writes it back where
@@ -564,6 +575,7 @@ class RuntimeMove:
     config: Configuration | None = None
     reason: str = ""
     controller_settings: bool = False
+    relative: Literal["base", "tool", "axes", "start"] | None = None
     span: SourceSpan = GENERATED
     kind: Literal["runtime_move"] = field(default="runtime_move", init=False)
 
@@ -580,6 +592,13 @@ class RuntimeMove:
             raise IRError(
                 f"RuntimeMove.angle: a circular move's, finite and not 0, got {self.angle}"
             )
+        if self.relative is not None and self.relative not in RUNTIME_RELATIVE:
+            raise IRError(
+                f"RuntimeMove.relative must be None or one of {RUNTIME_RELATIVE}, "
+                f"got {self.relative!r}"
+            )
+        if self.relative == "axes" and self.motion != "joint":
+            raise IRError("RuntimeMove.relative 'axes' is a joint move's (offsets of the axes)")
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

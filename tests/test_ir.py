@@ -169,3 +169,8 @@ def test_a_runtime_move_holds_an_expression_and_checks_its_shape() -> None:
         ir.RuntimeMove(motion="joint", target=path, angle=1.0)
     with pytest.raises(ir.IRError, match="motion"):
         ir.RuntimeMove(motion="spline", target=path)  # type: ignore[arg-type]
+    assert ir.RuntimeMove(motion="joint", target=path, relative="axes").relative == "axes"
+    with pytest.raises(ir.IRError, match="relative must be None or one of"):
+        ir.RuntimeMove(motion="linear", target=path, relative="world")  # type: ignore[arg-type]
+    with pytest.raises(ir.IRError, match="'axes' is a joint move's"):
+        ir.RuntimeMove(motion="linear", target=path, relative="axes")

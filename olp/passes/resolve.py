@@ -18,6 +18,8 @@
   (``runtime_target``) says why; the motion after it starts where olp does not know, so only
   its target is checked (reach, configuration, joint limits, in the solution nearest the last
   known joints) and its path is not: a warning (``unknown_start``), end joints but no path.
+  ``skip_unreachable`` skips such a motion as any; ``fallback_joint`` has nothing to change
+  there (:func:`_after_unknown_start`).
 
 The result is a :class:`olp.compiled.CompiledProgram`: the program, one step per instruction
 (end joints, resolved tool and frame, sampled joint path of a motion) and the diagnostics.
@@ -132,12 +134,15 @@ def resolve(
             progress.advance(1)
             continue
         if state.unknown_start is not None and isinstance(node, LinearPath):
-            step, found = _after_unknown_start(flat, node.move(0), station, state)
-            items.append(step)
-            diags.extend(found)
-            if len(node) > 1:
+            row = 0  # a row skipped there leaves the next one starting unknown too
+            while row < len(node) and state.unknown_start is not None:
+                step, found = _after_unknown_start(flat + row, node.move(row), station, state)
+                items.append(step)
+                diags.extend(found)
+                row += 1
+            if row < len(node):
                 found_items, found = _resolve_path(
-                    flat + 1, node.rows(1, len(node)), station, state
+                    flat + row, node.rows(row, len(node)), station, state
                 )
                 items.extend(found_items)
                 diags.extend(found)
@@ -222,7 +227,15 @@ def _after_unknown_start(
     joint move to it from the last known joints, whose path is then dropped). The joints
     taken are the solution nearest to the last known ones: the next motions are checked from
     there. A warning (``unknown_start``) says so; the step has end joints but no path (the
-    timing pass gives it no time)."""
+    timing pass gives it no time).
+
+    ``skip_unreachable`` applies as to any move: a target no joint move can reach (or only
+    beyond a joint limit) is skipped with a warning, and the robot stays where the run-time
+    motion left it, so the motion after the skipped one starts unknown too. ``fallback_joint``
+    does not: it writes a linear move that cannot run as a joint move to its target, and here
+    the check already is that joint move (from the last known joints, nearest solution), so
+    a target it fails is one a joint move fails too; the line itself is not checked, so no
+    fault of the line is left for a joint move to avoid."""
     runtime, state.unknown_start = state.unknown_start, None
     assert runtime is not None
     tool = ins.tool if ins.tool.pose is not None else station.tool(ins.tool)
@@ -238,6 +251,10 @@ def _after_unknown_start(
     path, checked = _joint_path(index, joint, tool, frame, state)
     found += checked
     if path is None:
+        skipped = _skipped(index, ins, tool, frame, state, found)
+        if skipped is not None:
+            state.unknown_start = runtime  # the robot stays where the run-time motion ended
+            return skipped
         _restart_at_target(ins, tool, frame, state)
         return Step(index=index, instruction=ins, tool=tool, frame=frame), found
     state.q = path[-1].copy()
@@ -796,15 +813,32 @@ def _recover(
                 index=index, instruction=joint, joints=path[-1], path=path, tool=tool, frame=frame
             )
             return step, [*[d for d in diags if d.severity != "error"], note]
-    errors = [d for d in diags if d.severity == "error"]
-    if opts.skip_unreachable and errors and all(d.kind in _UNREACHABLE for d in errors):
-        skipped = [
-            dataclasses.replace(d, severity="warning", message=f"skipped: {d.message}")
-            for d in errors
-        ]
-        return Step(index=index, instruction=ins, tool=tool, frame=frame, skipped=True), skipped
+    skipped = _skipped(index, ins, tool, frame, state, diags)
+    if skipped is not None:
+        return skipped
     _restart_at_target(ins, tool, frame, state)
     return Step(index=index, instruction=ins, tool=tool, frame=frame), diags
+
+
+def _skipped(
+    index: int,
+    ins: JointMove | LinearMove | CircularMove,
+    tool: Tool,
+    frame: Frame,
+    state: _State,
+    diags: list[Diagnostic],
+) -> tuple[Step, list[Diagnostic]] | None:
+    """With ``skip_unreachable``, a move whose errors all say its target cannot be reached
+    (``diags``) as a skipped step, its errors turned into warnings; else None."""
+    errors = [d for d in diags if d.severity == "error"]
+    if not (state.opts.skip_unreachable and errors):
+        return None
+    if not all(d.kind in _UNREACHABLE for d in errors):
+        return None
+    skipped = [
+        dataclasses.replace(d, severity="warning", message=f"skipped: {d.message}") for d in errors
+    ]
+    return Step(index=index, instruction=ins, tool=tool, frame=frame, skipped=True), skipped
 
 
 def _restart_at_target(

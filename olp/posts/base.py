@@ -178,6 +178,9 @@ class Post:
     RUNTIME_REFUSAL: ClassVar[str] = ""
     """Why the post cannot write motions to run-time targets (``runtime_move`` not in
     :attr:`KINDS`), for the error on such a motion."""
+    RUNTIME_RELATIVE: ClassVar[frozenset[str]] = frozenset()
+    """The :attr:`olp.ir.RuntimeMove.relative` forms this language writes (a target that
+    refers to a start position known only at run time); any other is an error on its line."""
     ARC_ANGLE: ClassVar[bool] = False
     """Whether a circular move's circular angle (KUKA's CA) can be written."""
     ACCELERATIONS: ClassVar[frozenset[str]] = frozenset()
@@ -592,6 +595,8 @@ class Post:
                 "statement of another language, kept as written, sets before it"
             )
             return [_error("runtime_target", msg, step)]
+        if ins.relative is not None and ins.relative not in self.RUNTIME_RELATIVE:
+            return [_error("runtime_target", _relative_refusal(self.LANGUAGE, what, ins), step)]
         return self._arc_checks(step, ins) if ins.motion == "circular" else []
 
     def _arc_checks(self, step: Step, ins: Any) -> list[Diagnostic]:
@@ -760,6 +765,23 @@ _NODE_LIMITS = {
 
 def _error(kind: str, message: str, step: Step, hint: str | None = None) -> Diagnostic:
     return Diagnostic("error", kind, message, step.instruction.span, step.index, hint=hint)
+
+
+_RELATIVE_WORDS = {
+    "base": "offsets from its start position along and about the base's axes",
+    "tool": "offsets from its start position in the tool frame",
+    "axes": "offsets added to the axis values it starts at",
+    "start": "a position whose components left out are those of its start position",
+}
+
+
+def _relative_refusal(language: str, what: str, ins: Any) -> str:
+    """Why a post cannot write a run-time motion whose target refers to its start."""
+    return (
+        f"the {language} post cannot write {what}: its target is "
+        f"{_RELATIVE_WORDS[ins.relative]}, which the robot reaches only at run time, and olp "
+        f"writes that only in the source's own language"
+    )
 
 
 def _warning(kind: str, message: str, step: Step) -> Diagnostic:

@@ -56,7 +56,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from olp.diagnostics import Diagnostic
 from olp.errors import PostError
-from olp.ir import ArcOrientation, CartesianTarget
+from olp.ir import RUNTIME_RELATIVE, ArcOrientation, CartesianTarget
 from olp.ir_flow import FLOW_TYPES, Declare, Routine, leaves_and_blocks
 from olp.posts.base import Filter, Post
 from olp.posts.kuka_flow import (
@@ -466,6 +466,7 @@ class KukaPost(Post):
     WRITES_FLOW = True
     WRITES_ROUTINES = True
     KINDS: ClassVar[frozenset[str]] = Post.KINDS | EVENT_KINDS | {"runtime_move"}
+    RUNTIME_RELATIVE = frozenset(RUNTIME_RELATIVE)  # KRL's own forms (_REL, #TOOL, partial)
     NAME_RULE = NAME_RULE
     IO_RANGE = (1, 4096)
     CALL_ARGUMENTS = ArgumentRule(
@@ -577,8 +578,10 @@ class KukaPost(Post):
 
 def _runtime_checks(index: int, ins: Any, options: Mapping[str, Any]) -> list[Diagnostic]:
     """A motion to a run-time target is written back as ``PTP|LIN|CIRC <expression>``
-    (:func:`~olp.posts.kuka_flow.krl_expr`): every name in it must be a KRL name
-    (``runtime_target``, error); a PTP is checked like any (:func:`_joint_checks`)."""
+    (:func:`~olp.posts.kuka_flow.krl_expr`; ``PTP_REL|LIN_REL|CIRC_REL <expression>``, with
+    ``#TOOL`` where the offsets are the tool's, where :attr:`olp.ir.RuntimeMove.relative` says
+    so): every name in it must be a KRL name (``runtime_target``, error); a PTP is checked like
+    any (:func:`_joint_checks`)."""
     out = []
     for expr in (ins.target, ins.via):
         problem = None if expr is None else flow_expr_problem(expr)

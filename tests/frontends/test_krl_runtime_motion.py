@@ -173,3 +173,115 @@ def test_a_known_record_set_member_by_member_before_a_kept_bas_is_an_error() -> 
     body = (PDAT, "PDAT_ACT=pMine", "PDAT_ACT.VEL=50", "FDAT_ACT=FHOME")
     with pytest.raises(ParseError, match="this BAS reads PDAT_ACT, whose value olp knows"):
         lower(*body, "BAS (#PTP_PARAMS,100 )", "PTP  XHOME")
+
+
+HOME_FOLD = (
+    "$H_POS=XHOME",
+    "PDAT_ACT=PDEFAULT",
+    "BAS (#PTP_DAT )",
+    "BAS (#VEL_PTP,80 )",
+    "FDAT_ACT=FHOME",
+    "BAS (#FRAMES )",
+    "PTP  XHOME",
+)
+"""A HOME fold written as separate BAS commands (the form KSS writes too: PDAT, then the frames,
+then the speed), a known one (``#VEL_PTP``) between two that read ``$config.dat``."""
+
+
+def test_a_home_fold_of_several_bas_runs_with_the_controller_settings() -> None:
+    """Without ``$config.dat`` both ``BAS (#PTP_DAT )`` and ``BAS (#FRAMES )`` are kept; the
+    PTP after them runs with the controller's settings, and ``BAS (#VEL_PTP,80 )``, which olp
+    would otherwise write only as ``$VEL_AXIS`` before a modelled motion, is kept where it
+    stands (before: an error, the rule covered one BAS right before the motion)."""
+    result = lower(*HOME_FOLD, *AGAIN)
+    (home,) = runtime(result)
+    assert home.controller_settings and home.span.line == 8
+    texts = [
+        n.text if isinstance(n, ir.Verbatim) else type(n).__name__
+        for n in result.program
+        if isinstance(n, ir.Verbatim | ir.Assign | ir.RuntimeMove)
+    ]
+    assert texts == [
+        "$H_POS=XHOME",
+        "Assign",
+        "BAS (#PTP_DAT )",
+        "BAS (#VEL_PTP,80 )",
+        "Assign",
+        "BAS (#FRAMES )",
+        "RuntimeMove",
+    ]
+    with pytest.raises(ParseError, match=r"\(\$ACC_AXIS, \$APO.CDIS, \$BASE, \$TOOL\): BAS"):
+        lower(*HOME_FOLD, "PTP {A1 0,A2 -90,A3 90,A4 0,A5 30,A6 0} C_PTP")
+
+
+CP_FORM = (
+    "DECL LDAT LCPDAT4={VEL 2.0,ACC 100.0,APO_DIST 20.0,APO_FAC 50.0,ORI_TYP #VAR}",
+    "DECL FDAT FPick={TOOL_NO 1,BASE_NO 1,IPO_FRAME #BASE}",
+    "DECL E6POS XPick={X 480,Y 20,Z 350,A 0,B 90,C 0,S 6,T 27}",
+)
+LIN_FORM = ("LDAT_ACT=LCPDAT4", "FDAT_ACT=FPick", "BAS(#CP_PARAMS,0.5)", "LIN XPick C_DIS C_DIS")
+"""A LIN inline form whose data the module declares: it sets every setting a LIN uses."""
+
+
+def test_a_lin_form_after_the_home_fold_sets_all_it_uses_and_is_modelled() -> None:
+    """After the HOME fold the axis speeds and accelerations stay the run-time BAS's; a LIN
+    does not run with them (``$VEL_AXIS``/``$ACC_AXIS`` are PTP settings), and its inline form
+    set its tool, base, path speed and distance: an ordinary linear move (before: an error
+    naming ``BAS(#PTP_PARAMS)``). A PTP after it still runs with the unknown axis speeds."""
+    result = lower(*CP_FORM, *PENDANT_HOME, *LIN_FORM)
+    (lin,) = [m for m in result.program.motions() if isinstance(m, ir.LinearMove)]
+    assert lin.speed.linear == pytest.approx(0.5) and lin.zone.radius == pytest.approx(0.02)
+    assert lin.tool.number == 1 and lin.frame.number == 1
+    with pytest.raises(ParseError, match=r"\(\$ACC_AXIS, \$VEL_AXIS\): BAS\(#PTP_PARAMS\)"):
+        lower(*CP_FORM, *PENDANT_HOME, *LIN_FORM, "PTP XPick")
+
+
+def test_a_lin_after_the_home_fold_that_sets_nothing_names_what_it_lacks() -> None:
+    with pytest.raises(ParseError, match=r"\(\$APO.CDIS, \$BASE, \$TOOL, the speed\): BAS\(#PTP"):
+        lower(*CP_FORM, *PENDANT_HOME, "LIN XPick C_DIS")
+
+
+@pytest.mark.parametrize(
+    ("motion", "relative"),
+    [
+        ("LIN_REL {Z 50}", "base"),
+        ("LIN_REL {Z 50} #BASE", "base"),
+        ("LIN_REL {X -10,C 5} #TOOL", "tool"),
+        ("PTP_REL {A6 15}", "axes"),
+        ("LIN {Z 400} C_DIS", "start"),
+        ("PTP {Z 400,A 10}", "start"),
+    ],
+)
+def test_a_motion_relative_to_a_run_time_start_is_a_run_time_motion(
+    config: KrlData, motion: str, relative: str
+) -> None:
+    """The start of a _REL motion, or of a target that leaves components out, is where the
+    motion to a run-time target before it ends: its target is known only at run time too, a
+    :class:`~olp.ir.RuntimeMove` saying how it refers to the start (before: an error that olp
+    cannot know the start). The motion after it starts unknown in turn."""
+    body = ("DECL E6POS xPath[3]", "DECL INT i", *SETUP, "i = $IN[3]", "LIN xPath[i]")
+    result = lower(*body, motion, "LIN_REL {Z -50}", config=config)
+    first, rel, again = runtime(result)
+    assert first.relative is None and rel.relative == relative and again.relative == "base"
+    assert isinstance(rel.target, ir.Aggregate) and rel.span.line == 11
+    assert "relative to the start position" in rel.reason or "leaves out" in rel.reason
+    assert "the LIN at line 10 goes to a run-time target" in rel.reason
+
+
+def test_a_relative_motion_whose_start_is_unknown_for_another_reason_is_still_an_error() -> None:
+    with pytest.raises(ParseError, match="there is no earlier Cartesian target"):
+        lower("LIN_REL {Z 50}")
+    with pytest.raises(ParseError, match="the motion at line 2 went to axis values"):
+        lower(HOME, "LIN {Z 400}")
+
+
+def test_a_known_record_between_two_kept_bas_is_written_once() -> None:
+    """``FDAT_ACT=FPick`` (known) after ``BAS (#PTP_DAT )`` (run-time PDEFAULT) is written
+    before the kept ``BAS (#PTP_PARAMS,100 )`` that reads it; the motion after them, which
+    keeps the statements absorbed since the first BAS, does not write it a second time."""
+    body = (*CP_FORM, "PDAT_ACT=PDEFAULT", "BAS (#PTP_DAT )", "FDAT_ACT=FPick")
+    result = lower(*body, "BAS (#PTP_PARAMS,100 )", "PTP  XHOME")
+    (home,) = runtime(result)
+    assert home.controller_settings
+    lines = [n.span.line for n in result.program if isinstance(n, ir.Assign | ir.Verbatim)]
+    assert lines == sorted(set(lines)) and 7 in lines

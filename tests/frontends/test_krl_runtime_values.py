@@ -163,12 +163,18 @@ def test_bas_with_a_run_time_value_is_kept_and_the_next_motion_asks_for_settings
     config: KrlData,
 ) -> None:
     """``BAS(#PTP_PARAMS, v)`` with ``v`` known only at run time: the call is kept as written;
-    a motion that would run with the settings it made cannot be checked, and says so."""
+    the motion right after it (``$BASE``/``$TOOL`` set in between, kept as written too) runs
+    with the speeds it made, a run-time motion olp does not check; a second motion that would
+    run with them cannot be checked, and says so."""
     body = ("DECL REAL v", "v = $OV_PRO", "BAS(#PTP_PARAMS, v)")
     (bas,) = kept(parse(config, *body))
     assert bas.text == "BAS(#PTP_PARAMS, v)" and "run time" in bas.reason
-    with pytest.raises(ParseError, match=r"BAS\(#PTP_PARAMS\) at line 4"):
-        parse(config, *body, *FRAMES, HOME)
+    result = parse(config, *body, *FRAMES, HOME)
+    assert [n.text for n in kept(result)] == ["BAS(#PTP_PARAMS, v)", *FRAMES]
+    (home,) = [n for n in result.program if isinstance(n, ir.RuntimeMove)]
+    assert home.controller_settings and home.span.line == 7
+    with pytest.raises(ParseError, match=r"\(\$ACC_AXIS, \$VEL_AXIS, the speed\): BAS\(#PTP_"):
+        parse(config, *body, *FRAMES, HOME, HOME)
 
 
 def _inline_data() -> KrlData:

@@ -14,6 +14,7 @@ import olp
 from olp import ir
 from olp.geometry import transl
 from olp.passes.flow import motion_predecessors
+from olp.passes.resolve import ResolveOptions
 from olp.report import report_dict, summary
 
 REPO = Path(__file__).resolve().parents[2]
@@ -121,3 +122,36 @@ def test_a_run_time_motion_in_a_loop_times_its_paths(station: olp.Station) -> No
     shortest, longest = result.compiled.paths.shortest, result.compiled.paths.longest
     assert shortest is not None and longest is not None
     assert np.isfinite(longest.seconds) and longest.seconds >= shortest.seconds > 0
+
+
+def test_skip_unreachable_skips_an_unreachable_target_after_a_run_time_motion(
+    station: olp.Station,
+) -> None:
+    """With ``skip_unreachable`` the unreachable target after a run-time motion is skipped
+    with a warning as anywhere (before: an error); the robot stays where the run-time motion
+    left it, so the motion after the skipped one starts unknown too (only its target is
+    checked: the line from LEFT over axis 1 would be an error)."""
+    nodes = (ptp(station, LEFT, 2), runtime(3), lin(station, FAR, 4, lift=5.0))
+    options = ResolveOptions(skip_unreachable=True)
+    program = ir.Program(name="p", instructions=(HOME, *nodes, lin(station, RIGHT, 5)))
+    result = olp.build(station, program, post="kuka", collisions=None, options=options)
+    assert result.ok
+    steps = result.compiled.steps
+    assert steps[3].skipped and not steps[4].skipped and steps[4].joints is not None
+    found = [(d.severity, d.kind, d.span.line if d.span else None) for d in result.diagnostics]
+    assert ("warning", "unreachable", 4) in found and ("warning", "unknown_start", 5) in found
+    written = [line for line in result.files["p.src"].splitlines() if line.startswith("LIN")]
+    assert len(written) == 2 and written[0] == "LIN pCam"  # the skipped one is not written
+
+
+def test_fallback_joint_leaves_an_unreachable_target_after_a_run_time_motion_an_error(
+    station: olp.Station,
+) -> None:
+    """Only the target is checked there, as the joint move ``fallback_joint`` would write:
+    a target it fails stays an error (nothing is rewritten)."""
+    options = ResolveOptions(fallback_joint=True)
+    nodes = (HOME, ptp(station, LEFT, 2), runtime(3), lin(station, FAR, 4, lift=5.0))
+    program = ir.Program(name="p", instructions=nodes)
+    result = olp.build(station, program, post="kuka", collisions=None, options=options)
+    assert ("error", "unreachable", 4) in kinds(result)
+    assert isinstance(result.compiled.steps[3].instruction, ir.LinearMove)

@@ -184,3 +184,89 @@ def test_the_pendant_home_without_config_dat_is_written_without_settings(
     assert src[bas + 1] == "PTP XHOME" and src[bas + 2].startswith("$BASE = ")
     abb = build(station, tmp_path, lines, post="abb")
     assert any(e[0] == "runtime_target" and e[1] == 5 for e in errors(abb))
+
+
+RELATIVE = (
+    "DEF rel( )",
+    "DECL E6POS xPick[2]",
+    "DECL E6POS pUp={X 0,Y 0,Z 50,A 0,B 0,C 0}",
+    *SETUP,
+    HOME,
+    "LIN xPick[1]",
+    "LIN_REL {Z 50}",
+    "LIN_REL pUp #TOOL",
+    "LIN {Z 400} C_DIS",
+    "PTP_REL {A6 15}",
+    HOME,
+    "END",
+)
+"""Motions relative to the end of a run-time one (lines 10 to 13): run-time targets too."""
+
+
+def test_krl_writes_motions_relative_to_a_run_time_start_as_written(
+    station: olp.Station, tmp_path: Path
+) -> None:
+    result = build(station, tmp_path, RELATIVE)
+    assert result.ok, errors(result)
+    src = result.files["rel.src"].splitlines()
+    motions = [line for line in src if line.split(" ")[0] in ("LIN", "LIN_REL", "PTP_REL")]
+    assert motions == [
+        "LIN xPick[1]",
+        "LIN_REL {Z 50}",
+        "LIN_REL pUp #TOOL",
+        "LIN {Z 400} C_DIS",
+        "PTP_REL {A6 15}",
+    ]
+    warned = [d.span.line for d in result.diagnostics if d.kind == "runtime_target" and d.span]
+    assert warned == [9, 10, 11, 12, 13]
+
+
+@pytest.mark.parametrize("post", ["abb", "fanuc", "ur"])
+def test_other_posts_refuse_a_target_relative_to_a_run_time_start(
+    station: olp.Station, tmp_path: Path, post: str
+) -> None:
+    """RAPID would write ``MoveL pUp`` for ``LIN_REL pUp``: a motion to the offsets as a
+    position. Every post but KRL refuses each relative motion on its line (RAPID's ``Offs``
+    of ``CRobT()`` is not the same start: the robot's measured position, not the target the
+    previous motion ends at)."""
+    refused = {line for kind, line, _ in errors(build(station, tmp_path, RELATIVE, post=post))}
+    assert {10, 11, 12, 13} <= refused
+    messages = [m for k, line, m in errors(build(station, tmp_path, RELATIVE, post="abb"))]
+    assert any("offsets from its start position in the tool frame" in m for m in messages)
+
+
+def test_krl_reads_its_relative_motions_back_the_same(station: olp.Station, tmp_path: Path) -> None:
+    from olp.frontends.krl import parse_krl
+
+    written = build(station, tmp_path, RELATIVE).files["rel.src"]
+    again = parse_krl(written, "rel.src").program
+    relative = [n.relative for n in again if isinstance(n, ir.RuntimeMove)]
+    assert relative == [None, "base", "tool", "start", "axes"]
+
+
+def test_krl_writes_a_home_fold_of_several_bas_line_for_line(
+    station: olp.Station, tmp_path: Path
+) -> None:
+    """The fold without ``$config.dat``: every line of it written, in order, the known
+    ``BAS (#VEL_PTP,80 )`` among them, and nothing between the last BAS and ``PTP XHOME``."""
+    fold = (
+        "PDAT_ACT=PDEFAULT",
+        "BAS (#PTP_DAT )",
+        "FDAT_ACT=FHOME",
+        "BAS (#FRAMES )",
+        "BAS (#VEL_PTP,80 )",
+        "PTP  XHOME",
+    )
+    lines = ("DEF path( )", *fold, *SETUP, "BAS (#VEL_PTP, 50)", "BAS (#ACC_PTP, 50)", HOME, "END")
+    result = build(station, tmp_path, lines)
+    assert result.ok, errors(result)
+    src = result.files["path.src"].splitlines()
+    start = src.index("PDAT_ACT = PDEFAULT")
+    assert src[start : start + 6] == [
+        "PDAT_ACT = PDEFAULT",
+        "BAS (#PTP_DAT )",
+        "FDAT_ACT = FHOME",
+        "BAS (#FRAMES )",
+        "BAS (#VEL_PTP,80 )",
+        "PTP XHOME",
+    ]

@@ -54,11 +54,19 @@ What is lowered
   names the missing file). A ``_REL`` motion by run-time offsets is kept as written
   (:class:`olp.ir.Verbatim`), and only right after a modelled motion of its kind with the same
   settings, in the same straight stretch (elsewhere an error saying why). A name declared
-  nowhere else stays an error naming the data list that would declare it.
+  nowhere else stays an error naming the data list that would declare it. A motion whose
+  target refers to its start position (``LIN_REL {Z 50}``, ``PTP_REL {A6 15}``, ``LIN {Z
+  500}``) right where a run-time motion left the robot is a run-time motion too, its target
+  the expression and ``relative`` saying how it refers to the start (only KRL writes it).
 * **BAS with run-time values** (``BAS(#PTP_PARAMS, v)``, or ``PDAT_ACT`` given a parameter) is
-  kept as written; the settings it sets are ambiguous until set again, and a motion (a
-  run-time one too) after it in the same straight stretch is an error (the output would not
-  write the settings that BAS changed behind its back). A settings routine without motions builds.
+  kept as written; the settings it sets are ambiguous until set again, and a motion that runs
+  with one of them (a PTP: tool, base, axis speeds and accelerations; a LIN/CIRC: tool, base,
+  path speed, ``$ORI_TYPE``/``$CIRC_TYPE``; an approximated one: ``$APO.CDIS``) is an error
+  naming them (the output would not write the settings that BAS changed behind its back),
+  except the motion right after the BAS commands of one straight stretch (the pendant's HOME
+  fold): a run-time motion with the controller's settings, the settings statements olp
+  absorbed since the first of those BAS kept as written before it. A settings routine without
+  motions builds.
 * **Unrolled FOR loops** write ``counter = n`` before a pass whose output reads the counter
   (a run-time motion such as ``LIN xPath[i]``, a statement kept as written such as
   ``r[i] = $OV_PRO``, ``Foo(i)``).

@@ -61,7 +61,7 @@ from olp.frontends.krl.flow import (
     to_expr,
 )
 from olp.frontends.krl.module_data import with_module_data
-from olp.frontends.krl.motion import _BASE_MOTION, Motions
+from olp.frontends.krl.motion import Motions
 from olp.frontends.krl.routines import PendingCall, assemble, moves, typed_params
 from olp.frontends.krl.rows import build_instructions
 from olp.frontends.krl.state import (
@@ -162,6 +162,7 @@ class _Lowering(Motions, Events):
         self.past: set[str] = set()  # counters of unrolled FOR loops (see flow.PastFor)
         # statements that set motion settings (absorbed into the motions) since the last motion
         self.unwritten: list[Stmt] = []
+        self.unwritten_at: list[tuple[list[Any], int]] = []  # each one's output list, position
         self._blocks: dict[str, Callable[[Block], None]] = {
             "IF": self._if,
             "SWITCH": self._switch,
@@ -210,6 +211,7 @@ class _Lowering(Motions, Events):
         if isinstance(stmt, LinRows):  # checks and spends per row itself
             self._lin_rows(stmt)
             self.unwritten.clear()
+            self.unwritten_at.clear()
             return
         if self.returned is not None:
             routine, line = self.returned
@@ -223,19 +225,19 @@ class _Lowering(Motions, Events):
             return
         if self.ambiguous and isinstance(stmt, MotionStmt | FastMotion):
             motion = materialise(stmt) if isinstance(stmt, FastMotion) else stmt
-            used = [why for name, why in self.ambiguous.items() if _uses_setting(motion, name)]
-        else:
-            used = []
-        if used:
-            if self._controller_settings_motion(motion):
+            unsettled = self._unsettled(motion)
+            if unsettled and self._controller_settings_motion(motion, unsettled):
                 self.ctx.spend(stmt)
                 return
-            reasons = "; ".join(sorted(set(used)))
-            raise self._error(
-                f"olp cannot tell which motion settings this motion runs with: {reasons}",
-                stmt.span,
-                hint="set them again before the motion (the pendant's inline forms do)",
-            )
+            if unsettled:
+                names = ", ".join(sorted(_SETTING_NAMES[n] for n in unsettled))
+                reasons = "; ".join(sorted(set(unsettled.values())))
+                raise self._error(
+                    f"olp cannot tell which motion settings this motion runs with ({names}): "
+                    f"{reasons}",
+                    stmt.span,
+                    hint="set them again before the motion (the pendant's inline forms do)",
+                )
         self.ctx.spend(stmt)
         past = self._past_counters(stmt)
         start, reported = len(self.out), len(self.ignored)
@@ -277,8 +279,10 @@ class _Lowering(Motions, Events):
         one that no motion follows is not in the output (:meth:`report_unwritten_settings`)."""
         if moves(new) or any(isinstance(n, Pending | PendingRows) for n in leaves(new)):
             self.unwritten.clear()
+            self.unwritten_at.clear()
         elif isinstance(stmt, Assign | CallStmt) and not new and not reported:
             self.unwritten.append(stmt)
+            self.unwritten_at.append((self.out, len(self.out)))
 
     def report_unwritten_settings(self) -> None:
         """Warn about the settings no motion of the program follows (a routine that sets
@@ -290,6 +294,7 @@ class _Lowering(Motions, Events):
                 "only before the motions that use them, so this one is not in the output",
             )
         self.unwritten.clear()
+        self.unwritten_at.clear()
 
     # ---- motions to where the robot is
     def _motion_or_here(self, stmt: MotionStmt) -> None:
@@ -676,7 +681,7 @@ class _Lowering(Motions, Events):
                 self.status_turn,
             )
             child._reported = self._reported
-            child.unwritten = self.unwritten
+            child.unwritten, child.unwritten_at = self.unwritten, self.unwritten_at
         return child
 
     def _branch(self, body: Sequence[Stmt], loop: bool = False) -> tuple[_Lowering, Body]:
@@ -894,23 +899,6 @@ _SETTING_NAMES = {
     "ori_type": "$ORI_TYPE",
     "circ_type": "$CIRC_TYPE",
 }
-
-
-def _uses_setting(motion: MotionStmt, name: str) -> bool:
-    """Whether ``motion`` runs with motion setting ``name`` (a field of :class:`State`).
-
-    ``$APO.CDIS`` is the distance of a ``C_DIS`` approximation (KSS 8 "Approximate
-    positioning": the motion's approximation parameter names which ``$APO`` component
-    applies; without one the motion is an exact stop), and ``$CIRC_TYPE`` applies to circular
-    motions only. A motion without approximation, or not a CIRC, may run where the paths that
-    reach it disagree on that setting (a loop that writes ``$APO.CDIS`` before its C_DIS
-    motion, as the KRL post does): the setting stays ambiguous for the next motion that
-    uses it. Every other setting is taken as used by every motion."""
-    if name == "cdis_mm":
-        return bool(motion.approx)
-    if name == "circ_type":
-        return _BASE_MOTION.get(motion.keyword) == "CIRC"
-    return True
 
 
 # ------------------------------------------------------------------------------------------------

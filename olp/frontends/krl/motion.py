@@ -10,7 +10,7 @@ import dataclasses
 import math
 import re
 from collections.abc import Callable
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
@@ -65,6 +65,13 @@ _LIN_APPROX = frozenset({("C_DIS",), ("C_DIS", "C_DIS")})
 _FAST_KEYWORDS = {"PTP": "PTP", "SPTP": "PTP", "LIN": "LIN", "SLIN": "LIN"}
 _AXIS_SET = frozenset(AXES)
 _CARTESIAN_SET = frozenset(CARTESIAN)
+_USED_SETTINGS: dict[str, frozenset[str]] = {
+    "PTP": frozenset({"vel_axis", "acc_axis", "speed", "tool", "frame"}),
+    "LIN": frozenset({"speed", "tool", "frame", "ori_type"}),
+    "CIRC": frozenset({"speed", "tool", "frame", "ori_type", "circ_type"}),
+}
+"""The motion settings (fields of :class:`~olp.frontends.krl.state.State`) a motion of each
+kind runs with, besides ``cdis_mm`` when it is approximated (see :meth:`Motions._unsettled`)."""
 
 
 class Motions(InlineForms):
@@ -191,9 +198,12 @@ class Motions(InlineForms):
                 stmt.frame_option.span,
             )
         runtime = None if self.ctx.probing_for else self._runtime_target(stmt)
-        if runtime is not None and relative:
+        if runtime is None and not self.ctx.probing_for:
+            runtime = self._runtime_start(stmt, base)
+        elif runtime is not None and relative:
             self._keep_runtime_motion(stmt, base, runtime)
-        elif stmt.with_clause:
+            return
+        if stmt.with_clause:
             self._with_motion(stmt, base, relative, runtime)
         elif runtime is not None:
             self._note_after_with(stmt)
@@ -259,35 +269,113 @@ class Motions(InlineForms):
                 target=self._target_expr(stmt.targets[-1]),
                 via=self._target_expr(stmt.targets[0]) if base == "CIRC" else None,
                 reason=reason,
+                relative=self._start_relative(stmt, base),
                 **fields,
             )
         )
-        self.track.lose(f"the {stmt.keyword} at line {stmt.span.line} goes to a run-time target")
+        self.track.lose(
+            RuntimeStart(f"the {stmt.keyword} at line {stmt.span.line} goes to a run-time target")
+        )
+
+    def _runtime_start(self, stmt: MotionStmt, base: str) -> str | None:
+        """Why ``stmt``'s target is known only when the program runs because it refers to the
+        start position (a _REL motion; an inline target that leaves components out, which
+        KRL takes from the start) and the motion before went to a run-time target, else None.
+        Such a motion is a :class:`~olp.ir.RuntimeMove` with ``relative`` saying how its target
+        refers to the start: the controller computes it, as from any start (before: an error
+        that olp cannot know the start). A start unknown for another reason (no Cartesian
+        target before, a motion to axis values, a WITH's $TOOL) stays the error it was."""
+        kind = self._start_relative(stmt, base)
+        if kind is None:
+            return None
+        joints = kind == "axes"
+        known = self.track.joints if joints else self.track.cartesian
+        lost = self.track.no_joints if joints else self.track.no_cartesian
+        if known is not None or not isinstance(lost, RuntimeStart):
+            return None
+        if kind == "start":
+            what = "takes the components its target leaves out from the start position"
+        else:
+            what = "moves relative to the start position"
+        return f"{stmt.keyword} {what}, and {lost}"
+
+    def _start_relative(self, stmt: MotionStmt, base: str) -> RelativeKind | None:
+        """How ``stmt``'s target refers to its start position (:attr:`olp.ir.RuntimeMove.relative`):
+        a _REL motion's offsets (``"axes"`` for a PTP_REL by axis values, else ``"tool"`` with
+        ``#TOOL``, ``"base"`` with ``#BASE`` or none: KRL's default), an inline target that
+        leaves Cartesian components out (``"start"``), else None. None too for a _REL motion
+        whose offsets or option olp would refuse anyway (the usual error then stands)."""
+        if not stmt.keyword.endswith("_REL"):
+            return self._partial_kind(stmt, base)
+        option = stmt.frame_option.name.upper() if stmt.frame_option is not None else "BASE"
+        if option not in ("BASE", "TOOL"):
+            return None
+        target = stmt.targets[-1]
+        if isinstance(target, Aggregate) and is_axis_aggregate(target):
+            return "axes" if base == "PTP" else None
+        if not isinstance(target, Aggregate) and base == "PTP":
+            value = self._value(target)
+            if isinstance(value, Aggregate) and is_axis_aggregate(value):
+                return "axes"
+        return "tool" if option == "TOOL" else "base"
+
+    @staticmethod
+    def _partial_kind(stmt: MotionStmt, base: str) -> RelativeKind | None:
+        """``"start"`` when an inline Cartesian target (or a CIRC's via point) of ``stmt``
+        leaves out some of X..C (KRL takes them from the start position), else None."""
+        for expr in stmt.targets:
+            if not isinstance(expr, Aggregate) or is_axis_aggregate(expr):
+                continue
+            names = {m.name.upper() for m in expr.members}
+            if not names >= _CARTESIAN_SET:
+                return "start"
+        return None
 
     def _target_expr(self, expr: Expr) -> ir.Expr:
         converted = to_expr(expr, self._input_of)
         assert converted is not None
         return converted
 
-    def _controller_settings_motion(self, stmt: MotionStmt) -> bool:
-        """The motion right after a BAS kept as written (its values known only at run time, a
-        ``$config.dat`` olp was not given among them: the pendant's ``FDAT_ACT=FHOME``,
-        ``BAS(#PTP_PARAMS,100)``, ``PTP XHOME``), in the same straight stretch, when that BAS
-        is all that leaves its settings unknown and no setting was assigned since it: a
+    def _unsettled(self, stmt: MotionStmt) -> dict[str, str]:
+        """The motion settings ``stmt`` runs with that are ambiguous here (``ambiguous``: set
+        from run-time values, or different between the paths that reach it), and why.
+
+        A motion runs with (and the posts write before it) its tool and base; a PTP with the
+        axis speeds and accelerations (``$VEL_AXIS``/``$ACC_AXIS``: the joint part of the speed,
+        which the KRL post writes only before a PTP and the timing applies only to joint moves,
+        :mod:`olp.passes.timing`); a LIN or CIRC with the path speed (``$VEL.CP``), ``$ORI_TYPE``
+        and a CIRC with ``$CIRC_TYPE``; an approximated motion with ``$APO.CDIS``. So a LIN
+        after ``BAS(#PTP_PARAMS)`` with run-time values, whose own inline form set the tool,
+        base, path speed and distance again (``BAS(#CP_PARAMS, 2)`` with known data), is
+        lowered as any: the axis speeds that BAS left unknown are not its settings. The speed
+        is one setting in olp (:class:`olp.ir.Speed`): what sets either part of it counts for
+        both (conservative: a LIN right after a run-time ``BAS(#VEL_PTP)`` still stops)."""
+        ambiguous: dict[str, str] = getattr(self, "ambiguous", {})
+        base = _BASE_MOTION.get(stmt.keyword, "PTP")
+        used = _USED_SETTINGS[base] | ({"cdis_mm"} if stmt.approx else set())
+        return {name: why for name, why in ambiguous.items() if name in used}
+
+    def _controller_settings_motion(self, stmt: MotionStmt, unsettled: dict[str, str]) -> bool:
+        """The motion right after the BAS commands kept as written (their values known only at
+        run time, a ``$config.dat`` olp was not given among them: the pendant's
+        ``FDAT_ACT=FHOME``, ``BAS(#PTP_PARAMS,100)``, ``PTP XHOME``, or the fold KSS writes as
+        ``PDAT_ACT=PDEFAULT``, ``BAS(#PTP_DAT)``, ``FDAT_ACT=FHOME``, ``BAS(#FRAMES)``,
+        ``BAS(#VEL_PTP,100)``, ``PTP XHOME``), in the same straight stretch, when those BAS
+        are all that leave its settings (``unsettled``, :meth:`_unsettled`) unknown: a
         :class:`~olp.ir.RuntimeMove` that runs with the controller's settings
         (``controller_settings``: the KRL post writes no setting before it, so the BAS's
-        hold), its target an expression. Not for a _REL or WITH
-        motion. Returns whether it lowered ``stmt`` (else the caller's error stands)."""
+        hold), its target an expression. The statements olp absorbed into the motion settings
+        since the first of those BAS (``BAS(#VEL_PTP,100)``, a ``$VEL.CP``) are kept as written
+        where they stand: the output writes settings only before the motions that use them,
+        and this one writes none, so without them it would run without what they set. Not for
+        a _REL or WITH motion. Returns whether it lowered ``stmt`` (else the caller's error
+        stands)."""
         bas = self._kept_bas_before()
         base = _BASE_MOTION.get(stmt.keyword)
-        ambiguous: dict[str, str] = getattr(self, "ambiguous", {})
-        from_bas = all(why.startswith("BAS(#") for why in ambiguous.values())
-        # nothing set since the BAS: a setting the program set in between is one the output
-        # would write only before a motion with settings, so this one would run without it
-        untouched = self.kept_bas is not None and self.kept_bas[0] is bas
-        untouched = untouched and self.kept_bas is not None and self.kept_bas[1] == self.state
+        from_bas = all(why.startswith("BAS(#") for why in unsettled.values())
+        latest = self.kept_bas is not None and self.kept_bas[0] is bas
         expected = 2 if base == "CIRC" else 1
-        if bas is None or base is None or not (from_bas and untouched):
+        if bas is None or base is None or not (from_bas and latest):
             return False
         if len(stmt.targets) != expected:
             return False
@@ -295,6 +383,7 @@ class Motions(InlineForms):
             return False
         self.motion_count += 1
         runtime = self._runtime_target(stmt)
+        self._keep_absorbed_since(self._first_kept_bas())
         why = f"its settings are what {bas.text} (line {bas.span.line}) sets at run time"
         if stmt.approx:
             self._note(
@@ -309,10 +398,13 @@ class Motions(InlineForms):
                 via=self._target_expr(stmt.targets[0]) if base == "CIRC" else None,
                 reason=why if runtime is None else f"{runtime}; {why}",
                 controller_settings=True,
+                relative=self._partial_kind(stmt, base),
                 span=stmt.span,
             )
         )
-        self.track.lose(f"the {stmt.keyword} at line {stmt.span.line} runs with unknown settings")
+        self.track.lose(
+            RuntimeStart(f"the {stmt.keyword} at line {stmt.span.line} runs with unknown settings")
+        )
         return True
 
     def _kept_bas_before(self) -> ir.Verbatim | None:
@@ -324,6 +416,40 @@ class Motions(InlineForms):
             if isinstance(node, ir.Verbatim) and node.reason.startswith("BAS #"):
                 return node
         return None
+
+    def _first_kept_bas(self) -> int:
+        """The position in the output of the first BAS kept as written in the straight stretch
+        that ends here (a motion is never between two: :meth:`_after_kept_settings`)."""
+        first = len(self.out)
+        for k in range(len(self.out) - 1, -1, -1):
+            node = self.out[k]
+            if isinstance(node, (ir.Label, ir.RuntimeMove, *ir.BLOCK_TYPES)):
+                break
+            if isinstance(node, ir.Verbatim) and node.reason.startswith("BAS #"):
+                first = k
+        return first
+
+    def _keep_absorbed_since(self, first: int) -> None:
+        """Keep as written, where they stand, the statements absorbed into the motion settings
+        (``unwritten``) after position ``first`` of this output (see
+        :meth:`_controller_settings_motion`); they are no longer waiting for a motion. One a
+        kept BAS already had written (a data record it reads) is not written twice."""
+        unwritten: list[Any] = getattr(self, "unwritten", [])
+        positions: list[tuple[list[Any], int]] = getattr(self, "unwritten_at", [])
+        written = {getattr(node, "span", None) for node in self.out[first:]}
+        since = [
+            k
+            for k, (out, at) in enumerate(positions)
+            if out is self.out and at > first and unwritten[k].span not in written
+        ]
+        for k in reversed(since):  # from the back: the positions before stay valid
+            self._keep(
+                unwritten[k],
+                "sets motion settings before a motion that runs with the "
+                "controller's settings (olp writes none before it)",
+            )
+            self.out.insert(positions[k][1], self.out.pop())
+            del unwritten[k], positions[k]
 
     def _keep_runtime_motion(self, stmt: MotionStmt, base: str, reason: str) -> None:
         """Keep a _REL motion by run-time offsets as written (:class:`~olp.ir.Verbatim`, with a
@@ -337,7 +463,9 @@ class Motions(InlineForms):
             f"{stmt.keyword} to a target olp cannot know offline ({reason}): kept as written "
             "and not checked (reach, limits, collisions, time)",
         )
-        self.track.lose(f"the {stmt.keyword} at line {stmt.span.line} goes to a run-time target")
+        self.track.lose(
+            RuntimeStart(f"the {stmt.keyword} at line {stmt.span.line} goes to a run-time target")
+        )
         self._after_with = None
 
     def _after_kept_settings(self, span: ir.SourceSpan) -> None:
@@ -741,6 +869,18 @@ def _offset(start: tuple[float, ...], delta: tuple[float, ...], option: str) -> 
 
 
 _RUNTIME_KINDS: dict[str, Any] = {"PTP": "joint", "LIN": "linear", "CIRC": "circular"}
+
+RelativeKind = Literal["base", "tool", "axes", "start"]
+
+
+class RuntimeStart(str):
+    """Why the robot's position is unknown, when it is because a motion went where only the
+    run time knows (a :class:`~olp.ir.RuntimeMove`, a motion kept as written): a motion that
+    refers to its start position is then a run-time motion too (:meth:`Motions._runtime_start`).
+    A ``str`` so that :class:`~olp.frontends.krl.state.Track` holds it as any reason."""
+
+    __slots__ = ()
+
 
 CONFIG_DAT_POINTS = frozenset({"XHOME", *(f"XHOME{n}" for n in range(1, 7))})
 """Points every KR C4 ``$config.dat`` declares (``E6AXIS XHOME``, ``XHOME1`` .. ``XHOME6``:
