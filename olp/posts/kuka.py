@@ -485,6 +485,15 @@ class KukaPost(Post):
     COLUMNS = True
     STREAMS = True
 
+    def comment_node_lines(self, comment: Any) -> tuple[str, ...]:
+        """A pendant fold line (``fold``) as it was read: its whole text, written after a ``;``
+        with no blank (``;FOLD PTP P1 ...;%{PE}...``, ``;ENDFOLD``), so that the pendant shows
+        the fold again; any other comment as every post writes it."""
+        if comment.fold is None:
+            return super().comment_node_lines(comment)
+        lines = self.comment_lines(comment.text)
+        return self._source_lines(lines) if comment.from_source else lines
+
     def step_columns(self, robot: Any, joints: Any) -> Mapping[str, Any]:
         """:meth:`step_values` as arrays (N,)."""
         q = np.asarray(joints, dtype=np.float64)

@@ -263,7 +263,7 @@ class _Renderer:
         if self.post.WRITES_FLOW and self.compiled.program.has_flow:
             # a program with control flow is rendered from steps only (Post.columns_enabled)
             if self.post.writes_routines():
-                lines = self.post.comment_lines
+                lines = self.post.comment_node_lines
                 routines = weave_routines(self.compiled.program, view, lines)
             view = weave(self.compiled.program, view)
         unit = Unit(unit_name or self.name, self.name, self.source, index, count, routine)
