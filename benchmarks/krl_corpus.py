@@ -35,7 +35,10 @@ zones, tools and bases (inline-form data, BAS, ``$VEL``/``$ACC``/``$TOOL``/``$BA
 ``inlined`` call of the module's own DEF, ``warned`` (reported as not in the output), or
 ``unaccounted`` (the figure that must be 0: listed). With the KUKA post it also reads the
 written ``.src`` again and compares its statements with the source's, in order
-(``krl_round_trip_differs``: "KRL -> KRL keeps every statement" wants 0).
+(``krl_round_trip_differs``: "KRL -> KRL keeps every statement" wants 0; comments apart,
+and the INI lines the post writes from its template where the source has none), and counts the
+source's comments and fold lines the written ``.src`` lacks (``comments_lost``: "KRL -> KRL
+keeps comments and folds" wants 0).
 
 The last lines are ``name: value unit``.
 """
@@ -85,6 +88,8 @@ class Tally:
     warned: int = 0
     unaccounted: list[str] = field(default_factory=list)
     round_trip_differs: list[str] = field(default_factory=list)
+    comments_in: int = 0
+    comments_lost: list[str] = field(default_factory=list)
 
 
 def construct_of(message: str, source_line: str | None) -> str:
@@ -174,6 +179,44 @@ def account(text: str, src: str, result: object, tally: Tally) -> None:
             tally.warned += 1
         else:
             tally.unaccounted.append(f"{src}:{number}: {line}")
+
+
+def comment_texts(text: str) -> list[str]:
+    """The comments of a KRL text (what follows the first ``;`` outside a string on each line
+    that is no ``&`` header), stripped, the characters outside ASCII as ``?`` (the KUKA post
+    writes ASCII)."""
+    from olp.frontends.krl.comments import comment_column
+
+    found = []
+    for raw in text.splitlines():
+        column = comment_column(raw)
+        if column is not None:
+            found.append(raw[column + 1 :].strip().encode("ascii", "replace").decode())
+    return found
+
+
+def decoded(data: bytes) -> str:
+    """A file's text as olp reads it: UTF-8, else Windows-1252, else Latin-1."""
+    for encoding in ("utf-8", "cp1252"):
+        try:
+            return data.decode(encoding)
+        except UnicodeDecodeError:
+            continue
+    return data.decode("latin-1")
+
+
+def count_comments(text: str, written: str, src: str, tally: Tally) -> None:
+    """Comments and fold lines of the source that the written .src lacks (each text counted as
+    often as it occurs; the post's own comments, the header, tool and base names, do not
+    make up for a lost one of the source's)."""
+    source = comment_texts(text)
+    left = collections.Counter(comment_texts(written))
+    tally.comments_in += len(source)
+    for comment in source:
+        if left[comment] > 0:
+            left[comment] -= 1
+        else:
+            tally.comments_lost.append(f"{src}: ;{comment[:60]}")
 
 
 def find_config(folder: Path) -> Path | None:
@@ -275,6 +318,8 @@ def _one(olp, path, station, options, post, tally, olp_error) -> str:  # type: i
     text = path.read_text(encoding="latin-1")
     account(text, src, result, tally)
     if post == "kuka":
+        (written,) = [t for n, t in result.files.items() if n.lower().endswith(".src")]
+        count_comments(decoded(path.read_bytes()), written, src, tally)
         try:
             same = round_trips(result, options)
         except olp_error as exc:  # the written KRL does not read again: a fault of olp's
@@ -292,7 +337,11 @@ def shape(program: object) -> list[str]:
     from olp.ir_flow import leaves_and_blocks
 
     out = []
+    from olp.frontends.krl.native import is_ini_line
+
     for node in leaves_and_blocks(program.instructions):  # type: ignore[attr-defined]
+        if node.kind == "comment" or is_ini_line(node):  # (comments: comments_lost)
+            continue
         if node.kind == "verbatim":
             out.append(node.text.upper().replace(" ", ""))
         elif node.kind != "declare":
@@ -364,6 +413,10 @@ def main() -> None:
     for name in tally.round_trip_differs:
         print(f"  KRL -> KRL differs {name}")
     print(f"krl_round_trip_differs: {len(tally.round_trip_differs)} files")
+    for line in tally.comments_lost[:20]:
+        print(f"  comment lost {line}")
+    print(f"comments_in: {tally.comments_in} lines")
+    print(f"comments_lost: {len(tally.comments_lost)} lines")
     print(f"seconds: {seconds:.2f} s")
 
 

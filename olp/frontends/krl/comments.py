@@ -51,6 +51,7 @@ from olp.frontends.krl.ast import (
 )
 
 _FOLD = re.compile(r"(END)?FOLD\b", re.IGNORECASE)
+_END = re.compile(r"[ \t]*END(FCT)?\b", re.IGNORECASE)
 
 
 def scan(source: Source) -> list[CommentStmt]:
@@ -126,7 +127,7 @@ def attach(module: Module, source: Source) -> Module:
     placed: dict[int, Routine] = {}
     remaining = comments
     for number, routine in enumerate(routines):
-        end = code.last_before(routine.span.end_line or routine.span.line)
+        end = code.routine_end(routine.span.end_line or routine.span.line)
         mine = [c for c in remaining if c.span.line <= end or number == len(routines) - 1]
         remaining = remaining[len(mine) :]
         placed[id(routine)] = _place_routine(routine, mine, end, code)
@@ -261,6 +262,14 @@ class _CodeLines:
         number = line + 1
         while number <= len(self._lines) and not self._is_code(number):
             number += 1
+        return number
+
+    def routine_end(self, line: int) -> int:
+        """The ``END``/``ENDFCT`` line at or before ``line`` (a routine's span runs on over the
+        comment lines after its END, up to the next code line)."""
+        number = min(line, len(self._lines))
+        while number > 1 and not _END.match(self._lines[number - 1]):
+            number -= 1
         return number
 
     def last_before(self, line: int) -> int:
