@@ -38,7 +38,8 @@ written ``.src`` again and compares its statements with the source's, in order
 (``krl_round_trip_differs``: "KRL -> KRL keeps every statement" wants 0; comments apart,
 and the INI lines the post writes from its template where the source has none), and counts the
 source's comments and fold lines the written ``.src`` lacks (``comments_lost``: "KRL -> KRL
-keeps comments and folds" wants 0).
+keeps comments and folds" wants 0; ``comments_warned``: those of a routine olp leaves out
+with a warning at its head).
 
 The last lines are ``name: value unit``.
 """
@@ -90,6 +91,7 @@ class Tally:
     round_trip_differs: list[str] = field(default_factory=list)
     comments_in: int = 0
     comments_lost: list[str] = field(default_factory=list)
+    comments_warned: int = 0
 
 
 def construct_of(message: str, source_line: str | None) -> str:
@@ -181,17 +183,18 @@ def account(text: str, src: str, result: object, tally: Tally) -> None:
             tally.unaccounted.append(f"{src}:{number}: {line}")
 
 
-def comment_texts(text: str) -> list[str]:
-    """The comments of a KRL text (what follows the first ``;`` outside a string on each line
-    that is no ``&`` header), stripped, the characters outside ASCII as ``?`` (the KUKA post
-    writes ASCII)."""
+def comment_texts(text: str) -> list[tuple[int, str]]:
+    """The comments of a KRL text with their lines (what follows the first ``;`` outside a
+    string on each line that is no ``&`` header), stripped, the characters outside ASCII as
+    ``?`` (the KUKA post writes ASCII)."""
     from olp.frontends.krl.comments import comment_column
 
     found = []
-    for raw in text.splitlines():
+    for number, raw in enumerate(text.splitlines(), start=1):
         column = comment_column(raw)
         if column is not None:
-            found.append(raw[column + 1 :].strip().encode("ascii", "replace").decode())
+            comment = raw[column + 1 :].strip().encode("ascii", "replace").decode()
+            found.append((number, comment))
     return found
 
 
@@ -205,18 +208,44 @@ def decoded(data: bytes) -> str:
     return data.decode("latin-1")
 
 
-def count_comments(text: str, written: str, src: str, tally: Tally) -> None:
+def _unwritten_routines(text: str, src: str, result: object) -> list[tuple[int, int]]:
+    """The line ranges of the routines olp left out with a warning at their head (no IR node
+    of theirs in the program): their comments go with their statements."""
+    from olp.ir_flow import leaves_and_blocks
+
+    program = result.compiled.program  # type: ignore[attr-defined]
+    nodes = [*program.instructions, *(n for r in program.routines for n in r.body)]
+    kept = {n.span.line for n in leaves_and_blocks(nodes) if n.span.file == src}
+    warned = {
+        d.span.line
+        for d in result.diagnostics  # type: ignore[attr-defined]
+        if d.span is not None and d.span.file == src and d.severity in ("warning", "error")
+    }
+    starts = [n for n, raw in enumerate(text.splitlines(), start=1) if _ROUTINE.match(raw.strip())]
+    ends = [*starts[1:], len(text.splitlines()) + 1]
+    return [
+        (start, end)
+        for start, end in zip(starts, ends, strict=True)
+        if start in warned and not any(start < line < end for line in kept)
+    ]
+
+
+def count_comments(text: str, written: str, src: str, result: object, tally: Tally) -> None:
     """Comments and fold lines of the source that the written .src lacks (each text counted as
     often as it occurs; the post's own comments, the header, tool and base names, do not
-    make up for a lost one of the source's)."""
+    make up for a lost one of the source's), but for those of a routine olp left out with a
+    warning (``comments_warned``)."""
     source = comment_texts(text)
-    left = collections.Counter(comment_texts(written))
+    left = collections.Counter(comment for _, comment in comment_texts(written))
+    unwritten = _unwritten_routines(text, src, result)
     tally.comments_in += len(source)
-    for comment in source:
-        if left[comment] > 0:
+    for line, comment in source:
+        if any(start <= line < end for start, end in unwritten):
+            tally.comments_warned += 1
+        elif left[comment] > 0:
             left[comment] -= 1
         else:
-            tally.comments_lost.append(f"{src}: ;{comment[:60]}")
+            tally.comments_lost.append(f"{src}:{line}: ;{comment[:60]}")
 
 
 def find_config(folder: Path) -> Path | None:
@@ -319,7 +348,7 @@ def _one(olp, path, station, options, post, tally, olp_error) -> str:  # type: i
     account(text, src, result, tally)
     if post == "kuka":
         (written,) = [t for n, t in result.files.items() if n.lower().endswith(".src")]
-        count_comments(decoded(path.read_bytes()), written, src, tally)
+        count_comments(decoded(path.read_bytes()), written, src, result, tally)
         try:
             same = round_trips(result, options)
         except olp_error as exc:  # the written KRL does not read again: a fault of olp's
@@ -416,6 +445,7 @@ def main() -> None:
     for line in tally.comments_lost[:20]:
         print(f"  comment lost {line}")
     print(f"comments_in: {tally.comments_in} lines")
+    print(f"comments_warned: {tally.comments_warned} lines")
     print(f"comments_lost: {len(tally.comments_lost)} lines")
     print(f"seconds: {seconds:.2f} s")
 

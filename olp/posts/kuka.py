@@ -42,6 +42,9 @@ files ``tests/golden/kuka/``.
   every written value must be held by one to the resolution of :data:`NUMBERS`: positions to
   0.01 mm, angles to 0.001°.
 * Comments: ``;`` to the end of the line; a comment of several lines becomes several ``;`` lines.
+  A pendant fold read from KRL (``;FOLD ...``/``;ENDFOLD``) is written back as it was read
+  (:meth:`KukaPost.comment_node_lines`); a program read from KRL with its own ``;FOLD INI``
+  gets that INI (its lines kept as written) instead of the template's.
 * Call arguments: numbers, ``"strings"``, names, ``#ENUM`` values and ``$`` system variables.
 """
 

@@ -51,7 +51,7 @@ from olp.frontends.krl.ast import (
 )
 
 _FOLD = re.compile(r"(END)?FOLD\b", re.IGNORECASE)
-_END = re.compile(r"[ \t]*END(FCT)?\b", re.IGNORECASE)
+_END = re.compile(r"[ \t]*END(FCT|DAT)?\b", re.IGNORECASE)
 
 
 def scan(source: Source) -> list[CommentStmt]:
@@ -119,7 +119,7 @@ def attach(module: Module, source: Source) -> Module:
     if not comments:
         return module
     code = _CodeLines(source.lines)
-    datas = [(d.span.line, code.last_before(d.span.end_line or d.span.line)) for d in _dats(module)]
+    datas = [(d.span.line, code.routine_end(d.span.end_line or d.span.line)) for d in _dats(module)]
     comments = [c for c in comments if not any(lo <= c.span.line <= hi for lo, hi in datas)]
     routines = [item for item in module.items if isinstance(item, Routine)]
     if not routines or not comments:
@@ -265,16 +265,9 @@ class _CodeLines:
         return number
 
     def routine_end(self, line: int) -> int:
-        """The ``END``/``ENDFCT`` line at or before ``line`` (a routine's span runs on over the
-        comment lines after its END, up to the next code line)."""
+        """The ``END``/``ENDFCT``/``ENDDAT`` line at or before ``line`` (a routine's span runs
+        on over the comment lines after its END, up to the next code line)."""
         number = min(line, len(self._lines))
         while number > 1 and not _END.match(self._lines[number - 1]):
-            number -= 1
-        return number
-
-    def last_before(self, line: int) -> int:
-        """The last code line at or before ``line``."""
-        number = min(line, len(self._lines))
-        while number > 1 and not self._is_code(number):
             number -= 1
         return number
