@@ -35,7 +35,11 @@ zones, tools and bases (inline-form data, BAS, ``$VEL``/``$ACC``/``$TOOL``/``$BA
 ``inlined`` call of the module's own DEF, ``warned`` (reported as not in the output), or
 ``unaccounted`` (the figure that must be 0: listed). With the KUKA post it also reads the
 written ``.src`` again and compares its statements with the source's, in order
-(``krl_round_trip_differs``: "KRL -> KRL keeps every statement" wants 0).
+(``krl_round_trip_differs``: "KRL -> KRL keeps every statement" wants 0; comments apart,
+and the INI lines the post writes from its template where the source has none), and counts the
+source's comments and fold lines the written ``.src`` lacks (``comments_lost``: "KRL -> KRL
+keeps comments and folds" wants 0; ``comments_warned``: those of a routine olp leaves out
+with a warning at its head).
 
 With the KUKA post it also counts by text (:func:`count_text`): each statement of the source
 ``.src`` (a line of code: not blank, not only a comment or a fold line, not an ``&`` header;
@@ -98,6 +102,9 @@ class Tally:
     unaccounted: list[str] = field(default_factory=list)
     round_trip_differs: list[str] = field(default_factory=list)
     text: TextCount = field(default_factory=lambda: TextCount())
+    comments_in: int = 0
+    comments_lost: list[str] = field(default_factory=list)
+    comments_warned: int = 0
 
 
 @dataclass
@@ -289,6 +296,71 @@ def _kind(line: str) -> str:
     return "call" if rest.startswith("(") else "assignment"
 
 
+def comment_texts(text: str) -> list[tuple[int, str]]:
+    """The comments of a KRL text with their lines (what follows the first ``;`` outside a
+    string on each line that is no ``&`` header), stripped, the characters outside ASCII as
+    ``?`` (the KUKA post writes ASCII)."""
+    from olp.frontends.krl.comments import comment_column
+
+    found = []
+    for number, raw in enumerate(text.splitlines(), start=1):
+        column = comment_column(raw)
+        if column is not None:
+            comment = raw[column + 1 :].strip().encode("ascii", "replace").decode()
+            found.append((number, comment))
+    return found
+
+
+def decoded(data: bytes) -> str:
+    """A file's text as olp reads it: UTF-8, else Windows-1252, else Latin-1."""
+    for encoding in ("utf-8", "cp1252"):
+        try:
+            return data.decode(encoding)
+        except UnicodeDecodeError:
+            continue
+    return data.decode("latin-1")
+
+
+def _unwritten_routines(text: str, src: str, result: object) -> list[tuple[int, int]]:
+    """The line ranges of the routines olp left out with a warning at their head (no IR node
+    of theirs in the program): their comments go with their statements."""
+    from olp.ir_flow import leaves_and_blocks
+
+    program = result.compiled.program  # type: ignore[attr-defined]
+    nodes = [*program.instructions, *(n for r in program.routines for n in r.body)]
+    kept = {n.span.line for n in leaves_and_blocks(nodes) if n.span.file == src}
+    warned = {
+        d.span.line
+        for d in result.diagnostics  # type: ignore[attr-defined]
+        if d.span is not None and d.span.file == src and d.severity in ("warning", "error")
+    }
+    starts = [n for n, raw in enumerate(text.splitlines(), start=1) if _ROUTINE.match(raw.strip())]
+    ends = [*starts[1:], len(text.splitlines()) + 1]
+    return [
+        (start, end)
+        for start, end in zip(starts, ends, strict=True)
+        if start in warned and not any(start < line < end for line in kept)
+    ]
+
+
+def count_comments(text: str, written: str, src: str, result: object, tally: Tally) -> None:
+    """Comments and fold lines of the source that the written .src lacks (each text counted as
+    often as it occurs; the post's own comments, the header, tool and base names, do not
+    make up for a lost one of the source's), but for those of a routine olp left out with a
+    warning (``comments_warned``)."""
+    source = comment_texts(text)
+    left = collections.Counter(comment for _, comment in comment_texts(written))
+    unwritten = _unwritten_routines(text, src, result)
+    tally.comments_in += len(source)
+    for line, comment in source:
+        if any(start <= line < end for start, end in unwritten):
+            tally.comments_warned += 1
+        elif left[comment] > 0:
+            left[comment] -= 1
+        else:
+            tally.comments_lost.append(f"{src}:{line}: ;{comment[:60]}")
+
+
 def find_config(folder: Path) -> Path | None:
     found = sorted(p for p in folder.rglob("*") if p.name.lower() == "$config.dat")
     return found[0] if found else None
@@ -389,7 +461,8 @@ def _one(olp, path, station, options, post, tally, olp_error) -> str:  # type: i
     account(text, src, result, tally)
     if post == "kuka":
         count_text(text, src, result, tally.text)
-    if post == "kuka":
+        (written,) = [t for n, t in result.files.items() if n.lower().endswith(".src")]
+        count_comments(decoded(path.read_bytes()), written, src, result, tally)
         try:
             same = round_trips(result, options)
         except olp_error as exc:  # the written KRL does not read again: a fault of olp's
@@ -407,7 +480,11 @@ def shape(program: object) -> list[str]:
     from olp.ir_flow import leaves_and_blocks
 
     out = []
+    from olp.frontends.krl.native import is_ini_line
+
     for node in leaves_and_blocks(program.instructions):  # type: ignore[attr-defined]
+        if node.kind == "comment" or is_ini_line(node):  # (comments: comments_lost)
+            continue
         if node.kind == "verbatim":
             out.append(node.text.upper().replace(" ", ""))
         elif node.kind != "declare":
@@ -480,6 +557,11 @@ def main() -> None:
         print(f"  KRL -> KRL differs {name}")
     print(f"krl_round_trip_differs: {len(tally.round_trip_differs)} files")
     print_text_count(tally.text, args.verbose)
+    for line in tally.comments_lost[:20]:
+        print(f"  comment lost {line}")
+    print(f"comments_in: {tally.comments_in} lines")
+    print(f"comments_warned: {tally.comments_warned} lines")
+    print(f"comments_lost: {len(tally.comments_lost)} lines")
     print(f"seconds: {seconds:.2f} s")
 
 

@@ -660,11 +660,45 @@ class Call:
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Comment:
-    """A comment kept in the output."""
+    """A comment kept in the output.
+
+    ``fold``: the comment opens (``"open"``) or closes (``"close"``) a KUKA pendant fold, and
+    ``text`` is the line after its ``;`` as written (``FOLD PTP P1 CONT Vel=100 % PDAT1;%{PE}...``,
+    ``ENDFOLD``): one line, starting with ``FOLD`` or ``ENDFOLD``. The KRL post writes it back
+    unchanged (the pendant shows its folds again); other languages have no folds and write only
+    its :attr:`title` (see :meth:`olp.posts.base.Post.comment_node_lines`).
+
+    ``from_source``: read from a source program's comment (the KRL frontend's), not made for
+    the output: a character the output's encoding lacks is written as ``?`` with a warning
+    rather than stopping the build, since the program's own remark is not olp's to refuse.
+    """
 
     text: str
     span: SourceSpan = GENERATED
+    fold: Literal["open", "close"] | None = None
+    from_source: bool = False
     kind: Literal["comment"] = field(default="comment", init=False)
+
+    def __post_init__(self) -> None:
+        if self.fold is None:
+            return
+        keyword = "FOLD" if self.fold == "open" else "ENDFOLD"
+        if not self.text.upper().startswith(keyword) or self.fold not in ("open", "close"):
+            raise IRError(f"a fold's Comment.text starts with {keyword}, got {self.text!r}")
+        if any(c in _FOLD_BREAKS or (ord(c) < 32 and c != "\t") for c in self.text):
+            raise IRError(f"a fold's Comment.text must be one line, got {self.text!r}")
+
+    @property
+    def title(self) -> str:
+        """What a fold shows when closed: the text after ``FOLD`` up to the pendant's hidden
+        part (from the next ``;``), stripped; the comment's whole text if it is no fold."""
+        if self.fold is None:
+            return self.text
+        keyword = "FOLD" if self.fold == "open" else "ENDFOLD"
+        return self.text[len(keyword) :].split(";", 1)[0].strip()
+
+
+_FOLD_BREAKS = frozenset("\n\r\x0b\x0c\x1c\x1d\x1e\x85\u2028\u2029")
 
 
 Motion: TypeAlias = JointMove | LinearMove | CircularMove

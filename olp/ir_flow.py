@@ -37,11 +37,22 @@ class Verbatim:
 
     The text can never become more than one statement of the output: it must be one line
     without control characters (checked here, and again by the post that writes it).
+
+    ``native_only``: the statement matters only on a controller of its own ``language`` and,
+    where it stands, changes nothing olp models (no variable of the program, no motion, no
+    motion setting a later motion relies on): the pendant's ``$BWDSTART = FALSE`` in each
+    inline form, the standard lines of the pendant's INI fold before the first motion. A post
+    of the same language writes it as any verbatim statement, except that the next motion need
+    not write its settings again; any other post leaves it out with a warning giving
+    ``reason`` (kind ``ignored``) instead of the error; passes treat it as absent. A statement
+    that may change what olp models (a BAS with run-time values, ``$ACC.CP``) is never
+    native-only: leaving it out would change what the robot does.
     """
 
     text: str
     language: str
     reason: str = ""
+    native_only: bool = False
     span: SourceSpan = GENERATED
     kind: Literal["verbatim"] = field(default="verbatim", init=False)
 

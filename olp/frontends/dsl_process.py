@@ -340,7 +340,7 @@ def _rebuilt_result(result: DslResult, program: _Program) -> DslResult:
     on the program."""
     try:
         rebuilt: DslResult = _rebuilt(result)
-    except (ValueError, TypeError) as exc:
+    except (ValueError, TypeError, AttributeError) as exc:  # (a forged object lacking a field)
         raise program.error(
             f"the program's result holds an instruction olp's IR does not allow: "
             f"{_short(str(exc))}",

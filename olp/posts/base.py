@@ -525,6 +525,30 @@ class Post:
         """A comment's lines as this language writes them (checked by :meth:`check`)."""
         return tuple(self.COMMENTS.lines(text))
 
+    def comment_node_lines(self, comment: Any) -> tuple[str, ...]:
+        """The lines an :class:`~olp.ir.Comment` is written as, each through the language's
+        comment rule (:meth:`comment_lines`).
+
+        A KUKA pendant fold (``fold``) is written as its :attr:`~olp.ir.Comment.title` alone
+        when it opens, and not at all when it closes: the languages other than KRL have no
+        folds, and what follows a fold header's title (``;%{PE}%R 8.3.31,%MKUKATPBASIS,...``)
+        is the pendant's record of its inline form, noise to a reader of RAPID, URScript or
+        LS; the title (``PTP P1 CONT Vel=100 % PDAT1``) still says what the lines below do. A
+        comment read from a source program (``from_source``) has the characters the output's
+        encoding lacks written as ``?`` (:meth:`check` warns where it does).
+        """
+        if comment.fold == "close" or (comment.fold == "open" and not comment.title):
+            return ()
+        lines = self.comment_lines(comment.title)
+        return self._source_lines(lines) if comment.from_source else lines
+
+    def _source_lines(self, lines: tuple[str, ...]) -> tuple[str, ...]:
+        """A source comment's ``lines`` with the characters the encoding lacks as ``?``."""
+        encoding = self.manifest.encoding
+        if all(encodable(line, encoding) is None for line in lines):
+            return lines
+        return tuple(plain(line, encoding) for line in lines)
+
     def plain_text(self, text: str) -> str:
         """Informational text (a file name in a header comment): control characters and
         characters the output encoding lacks become ``?``."""
@@ -560,7 +584,7 @@ class Post:
             msg = f"the {self.LANGUAGE} post cannot write {article} {what} instruction"
             return [_error("unsupported", msg, step)]
         if kind == "comment":
-            return self._comment_checks(step, ins.text)
+            return self._comment_checks(step, ins)
         if kind == "call":
             return self._call_checks(step, ins.name, ins.args)
         if kind in ("set_output", "wait_input"):
@@ -619,12 +643,19 @@ class Post:
             out.append(_error("arc_angle", msg, step, hint=hint))
         return out
 
-    def _comment_checks(self, step: Step, text: str) -> list[Diagnostic]:
+    def _comment_checks(self, step: Step, comment: Any) -> list[Diagnostic]:
         try:
-            lines = self.COMMENTS.lines(text)
+            lines = self.comment_lines(comment.text)
         except ValueError as exc:
             return [_error("comment", f"comment holds a {exc}: it cannot be written", step)]
-        return self._encoding_checks(step, "comment", "\n".join(lines))
+        found = self._encoding_checks(step, "comment", "\n".join(lines))
+        if not found or not comment.from_source:
+            return found
+        msg = (
+            f"the program's comment {_quote(comment.text)} holds characters a "
+            f"{self.manifest.encoding} {self.LANGUAGE} file cannot hold: written as '?'"
+        )
+        return [_warning("comment", msg, step)]
 
     def _flow_error(self, compiled: CompiledProgram) -> Diagnostic:
         from olp.ir_flow import FLOW_TYPES, leaves_and_blocks
@@ -650,10 +681,15 @@ class Post:
 
     def _verbatim_checks(self, step: Step, ins: Any) -> list[Diagnostic]:
         """A statement kept as source text goes out unchanged to its own language only; it was
-        checked to be one line when made, so it cannot start another statement."""
+        checked to be one line when made, so it cannot start another statement. One that
+        matters only on its own language's controller (``native_only``) is left out of any
+        other with a warning giving its reason."""
         if ins.language == self.VERBATIM:
             return self._encoding_checks(step, "verbatim", ins.text)
         what = f"{ins.language.upper()} statement {_quote(ins.text)} (line {ins.span.line})"
+        if ins.native_only:
+            msg = f"{what} is not written: {ins.reason}"
+            return [Diagnostic("warning", "ignored", msg, ins.span, step.index)]
         if self.options.get("foreign_verbatim") == "drop":
             msg = (
                 f"{what} is not written: foreign_verbatim: drop (olp build "

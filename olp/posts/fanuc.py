@@ -107,7 +107,7 @@ from olp.posts.rows import PostRows
 from olp.posts.runtime import targets as runtime_targets
 from olp.posts.sandbox import SafeText
 from olp.posts.text import ArgumentRule, CommentRule, NameRule
-from olp.posts.view import OPAQUE_KINDS, PostStep, RowColumns
+from olp.posts.view import OPAQUE_KINDS, PostStep, RowColumns, is_opaque
 from olp.vendors.fanuc import (
     candidates,
     config_from_joints,
@@ -293,7 +293,7 @@ def ls_moves(
     last: tuple[int, int] | None = None
     number = 0
     for step in steps:
-        if step.kind in JUMP_TARGETS or step.kind in OPAQUE_KINDS:
+        if step.kind in JUMP_TARGETS or (step.kind in OPAQUE_KINDS and is_opaque(step.instruction)):
             last = None  # arrived from elsewhere, or a called routine may have set others
             continue
         if isinstance(step, RowColumns):

@@ -172,7 +172,7 @@ class _Weaver:
         """A step for a statement of a routine no call expands (never a motion)."""
         if isinstance(node, ir.RoutineCall):
             return _marker("routine_call", node, node.span)
-        comment = tuple(self.lines(node.text)) if node.kind == "comment" and self.lines else ()
+        comment = tuple(self.lines(node)) if node.kind == "comment" and self.lines else ()
         return PostStep(-1, node.kind, node.span.location, node, comment=comment)
 
     def block(self, node: Any) -> Iterator[PostStep]:

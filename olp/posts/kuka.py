@@ -42,6 +42,9 @@ files ``tests/golden/kuka/``.
   every written value must be held by one to the resolution of :data:`NUMBERS`: positions to
   0.01 mm, angles to 0.001°.
 * Comments: ``;`` to the end of the line; a comment of several lines becomes several ``;`` lines.
+  A pendant fold read from KRL (``;FOLD ...``/``;ENDFOLD``) is written back as it was read
+  (:meth:`KukaPost.comment_node_lines`); a program read from KRL with its own ``;FOLD INI``
+  gets that INI (its lines kept as written) instead of the template's.
 * Call arguments: numbers, ``"strings"``, names, ``#ENUM`` values and ``$`` system variables.
 """
 
@@ -493,6 +496,15 @@ class KukaPost(Post):
     ROWS = True
     COLUMNS = True
     STREAMS = True
+
+    def comment_node_lines(self, comment: Any) -> tuple[str, ...]:
+        """A pendant fold line (``fold``) as it was read: its whole text, written after a ``;``
+        with no blank (``;FOLD PTP P1 ...;%{PE}...``, ``;ENDFOLD``), so that the pendant shows
+        the fold again; any other comment as every post writes it."""
+        if comment.fold is None:
+            return super().comment_node_lines(comment)
+        lines = self.comment_lines(comment.text)
+        return self._source_lines(lines) if comment.from_source else lines
 
     def step_columns(self, robot: Any, joints: Any) -> Mapping[str, Any]:
         """:meth:`step_values` as arrays (N,)."""

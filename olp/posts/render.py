@@ -265,7 +265,7 @@ class _Renderer:
         if self.post.WRITES_FLOW and self.compiled.program.has_flow:
             # a program with control flow is rendered from steps only (Post.columns_enabled)
             if self.post.writes_routines():
-                lines = self.post.comment_lines
+                lines = self.post.comment_node_lines
                 routines = weave_routines(self.compiled.program, view, lines)
             view = weave(self.compiled.program, view)
         params = self.compiled.program.params if index == 0 else ()

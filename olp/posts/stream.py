@@ -390,7 +390,7 @@ class StreamedRender:
         assert self.view is not None
         ins = step.instruction
         if not is_motion(ins):
-            lines = self.post.comment_lines(ins.text) if ins.kind == "comment" else ()
+            lines = self.post.comment_node_lines(ins) if ins.kind == "comment" else ()
             return PostStep(step.index, ins.kind, ins.span.location, ins, comment=lines)
         if step.index not in self.view.motions:
             return None

@@ -60,6 +60,8 @@ class ViewHooks(Protocol):
 
     def comment_lines(self, text: str) -> tuple[str, ...]: ...
 
+    def comment_node_lines(self, comment: Any) -> tuple[str, ...]: ...
+
 
 @dataclass(frozen=True, slots=True, eq=False)
 class PostTool:
@@ -533,9 +535,9 @@ class ProgramView:
                 if _written_runtime(step):
                     out.append(self._runtime_step(step, names, last))
             elif not isinstance(ins, MOTION_TYPES):
-                lines = self.post.comment_lines(ins.text) if ins.kind == "comment" else ()
+                lines = self.post.comment_node_lines(ins) if ins.kind == "comment" else ()
                 out.append(PostStep(step.index, ins.kind, ins.span.location, ins, comment=lines))
-                if ins.kind in OPAQUE_KINDS:
+                if is_opaque(ins):
                     last.clear()  # the next motion sets everything again
             elif step.index in self.motions:
                 out.append(self._motion_step(step, names, last))
@@ -667,6 +669,12 @@ OPAQUE_KINDS = frozenset({"call", "verbatim"})
 """Instructions that may change the controller's motion settings (a called routine, a kept
 line olp does not model: either may set another tool, base, speed or zone): the first motion
 after one gets every ``new_*`` flag, so the post writes all its settings again."""
+
+
+def is_opaque(ins: Any) -> bool:
+    """Whether ``ins`` may change the controller's motion settings (:data:`OPAQUE_KINDS`; a
+    verbatim statement marked ``native_only`` changes none of them)."""
+    return ins.kind in OPAQUE_KINDS and not getattr(ins, "native_only", False)
 
 
 def _changed_object(last: dict[str, Any], key: str, value: Any) -> bool:

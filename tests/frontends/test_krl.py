@@ -179,7 +179,10 @@ def test_load_krl_falls_back_to_cp1252(tmp_path: Path) -> None:
     path = tmp_path / "umlaut.src"
     text = program("; Bahn für Fräser, 5 €", "PTP {A1 1,A2 2,A3 3,A4 4,A5 5,A6 6}")
     path.write_bytes(text.encode("cp1252"))
-    assert len(load_krl(path).program) == 1
+    comment, move = load_krl(path).program.instructions  # the comment is kept, decoded
+    assert comment == ir.Comment(
+        text="Bahn für Fräser, 5 €", span=comment.span, from_source=True
+    ) and isinstance(move, ir.JointMove)
     bom = tmp_path / "bom.src"
     bom.write_bytes(b"\xef\xbb\xbf" + program("WAIT SEC 1").encode())
     wait = ir.Wait(seconds=1.0, span=ir.SourceSpan(str(bom), 2, 1, 2, 11))

@@ -11,6 +11,7 @@ import pytest
 import olp
 from olp import ir
 from olp.frontends.krl import load_krl
+from olp.frontends.krl.native import is_ini_line
 from olp.ir_flow import leaves_and_blocks
 
 REPO = Path(__file__).resolve().parents[2]
@@ -64,9 +65,11 @@ def _written(station: object, folder: Path, name: str, text: str) -> tuple[ir.Pr
 
 
 def _shape(program: ir.Program) -> list[str]:
-    """Every statement of the program and its routines, in order, by kind."""
+    """Every statement of the program and its routines, in order, by kind (comments apart, and
+    the INI lines the KRL post writes from its template where the source has none)."""
     nodes = [*program.instructions, *(n for r in program.routines for n in r.body)]
-    return [n.kind for n in leaves_and_blocks(nodes)]
+    kept = (n for n in leaves_and_blocks(nodes) if n.kind != "comment" and not is_ini_line(n))
+    return [n.kind for n in kept]
 
 
 def _read_again(folder: Path, name: str, written: str) -> ir.Program:

@@ -11,6 +11,7 @@ import pytest
 
 from olp import ir
 from olp.frontends.krl import load_krl, parse_krl
+from olp.frontends.krl.native import is_ini_line
 from olp.ir_flow import leaves_and_blocks
 
 REPO = Path(__file__).resolve().parents[2]
@@ -22,7 +23,8 @@ FULL = "{X 20.0,Y -110.0,Z 300.0,A -90.0,B 0.0,C 180.0,S 2,T 2}"
 def events(path: Path) -> list[ir.Node]:
     program = load_krl(path, CONFIG).program
     kinds = ("interrupt_decl", "interrupt", "trigger", "verbatim")
-    return [n for n in leaves_and_blocks(program.instructions) if n.kind in kinds]
+    nodes = leaves_and_blocks(program.instructions)
+    return [n for n in nodes if n.kind in kinds and not is_ini_line(n)]  # (the source's INI)
 
 
 def program_file(tmp_path: Path, *lines: str) -> Path:
@@ -32,6 +34,13 @@ def program_file(tmp_path: Path, *lines: str) -> Path:
 
 
 def test_the_corpus_program_lowers_every_interrupt_and_trigger() -> None:
+    program = load_krl(CORPUS / "Program" / "trigger_dispense.src", CONFIG).program
+    ini = [n for n in leaves_and_blocks(program.instructions) if is_ini_line(n)]
+    assert [(n.text, n.span.line) for n in ini] == [  # its INI fold's, for the KRL post only
+        ("GLOBAL INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )", 7),
+        ("INTERRUPT ON 3", 8),
+        ("BAS (#INITMOV,0 )", 9),
+    ]
     found = events(CORPUS / "Program" / "trigger_dispense.src")
     assert [(n.kind, n.span.line) for n in found] == [
         ("interrupt_decl", 12),

@@ -17,6 +17,7 @@ from olp.errors import ParseError
 from olp.frontends.bundled import KrlOptions
 from olp.frontends.krl import load_krl
 from olp.ir_flow import leaves_and_blocks
+from tests.krl_round_trip import statements
 
 REPO = Path(__file__).resolve().parents[2]
 STATION = REPO / "stations" / "kr6_milling_cell.yaml"
@@ -28,9 +29,11 @@ def station() -> object:
 
 
 def shape(program: object) -> list[str]:
-    """Statements and blocks in order, declarations apart: kind, or the text of a kept line."""
+    """Statements and blocks in order, declarations apart: kind, or the text of a kept line
+    (comments and the template's INI lines apart: :func:`tests.krl_round_trip.statements`)."""
     out = []
-    for node in leaves_and_blocks(program.instructions):  # type: ignore[attr-defined]
+    nodes = leaves_and_blocks(program.instructions)  # type: ignore[attr-defined]
+    for node in statements(nodes):
         if node.kind == "verbatim":
             out.append(node.text.upper().replace(" ", ""))
         elif node.kind != "declare":

@@ -100,7 +100,11 @@ def test_no_statement_of_the_program_is_dropped_at_info_level(station: object) -
         assert all(d.kind == "verbatim" for d in quiet), [d.format() for d in quiet]
         # facing_mill's one kept line was $ACC.CP, which olp now models (issue 13)
         assert quiet or name == "facing_mill.src"
-        assert any(d.kind == "ignored" and d.severity == "warning" for d in result.diagnostics)
+        # the pendant's $BWDSTART and INI lines are kept for the KRL post (issue 15)
+        assert not any(d.kind == "ignored" and d.severity == "warning" for d in result.diagnostics)
+    other = build(station, REPO / "examples" / "pendant_pick.src", "abb").diagnostics
+    warned = [d.message for d in other if d.kind == "ignored" and d.severity == "warning"]
+    assert any("$BWDSTART only matters when stepping backwards" in m for m in warned)
 
 
 def test_verbatim_is_one_line() -> None:

@@ -78,8 +78,18 @@ def pick(config: KrlData) -> KrlResult:
     return load_krl(PICK, config_dat=config)
 
 
+def statements(result: KrlResult) -> list[ir.Instruction]:
+    """The program's statements as checks see them, without the comments and the lines kept
+    for the KRL post alone (its INI fold's, each inline form's $BWDSTART)."""
+    return [
+        i
+        for i in result.program.expanded()
+        if not isinstance(i, ir.Comment) and not getattr(i, "native_only", False)
+    ]
+
+
 def test_pick_reads_the_dat_and_config(pick: KrlResult) -> None:
-    kinds = [(type(i).__name__, i.span.line) for i in pick.program.expanded()]
+    kinds = [(type(i).__name__, i.span.line) for i in statements(pick)]
     assert kinds == [
         ("Verbatim", 27),  # $H_POS=XHOME: kept as written (the controller's $IN_HOME)
         ("JointMove", 28),  # PTP XHOME
@@ -153,7 +163,7 @@ def test_pick_tools_and_bases_come_from_config(pick: KrlResult) -> None:
 
 
 def test_pick_io(pick: KrlResult) -> None:
-    io = [i for i in plain(pick) if not isinstance(i, (*ir.MOTION_TYPES, ir.Verbatim))]
+    io = [i for i in plain(pick) if not isinstance(i, (*ir.MOTION_TYPES, ir.Verbatim, ir.Comment))]
     assert io == [
         ir.SetOutput(index=17, value=True),
         ir.Wait(seconds=0.5),
@@ -168,20 +178,29 @@ def test_pick_lists_every_ignored_line_with_a_reason(pick: KrlResult) -> None:
     for item in pick.ignored:
         by_file.setdefault(Path(item.span.file).name, []).append((item.span.line, item.text))
         assert item.reason
-    src = by_file["pendant_pick.src"]
-    assert (12, "GLOBAL INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )") in src
-    assert (14, "BAS (#INITMOV,0 )") in src
-    assert [line for line, text in src if text.startswith("$BWDSTART")] == [
+    src = by_file.get("pendant_pick.src", [])
+    # the INI fold's lines and each inline form's $BWDSTART: kept for the KRL post alone
+    native = [(i.span.line, i.text) for i in pick.program.expanded() if i.kind == "verbatim"]
+    native = [
+        (line, text) for line, text in native if text.startswith(("$BWD", "GLOBAL", "I", "B"))
+    ]
+    assert native[:3] == [
+        (12, "GLOBAL INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )"),
+        (13, "INTERRUPT ON 3"),
+        (14, "BAS (#INITMOV,0 )"),
+    ]
+    assert [line for line, text in native if text.startswith("$BWDSTART")] == [
         23,
         32,
         40,
         57,
         65,
-        76,
         87,
         99,
-    ]
-    kept = [(i.span.line, i.text) for i in pick.program.expanded() if isinstance(i, ir.Verbatim)]
+        76,
+    ]  # (76: the PTP HOME fold at the end of the main program, after the inlined routine's)
+    assert not [line for line, text in src if text.startswith(("$BWD", "GLOBAL", "INTER", "BAS"))]
+    kept = [(i.span.line, i.text) for i in statements(pick) if isinstance(i, ir.Verbatim)]
     lines = [36, 44, 61, 69, 91, 103]  # SET_CD_PARAMS: kept in the program as written
     homes = [(27, "$H_POS=XHOME")], [(80, "$H_POS=XHOME")]  # the pendant's PTP HOME folds
     assert kept == [*homes[0], *[(line, "SET_CD_PARAMS (0)") for line in lines], *homes[1]]
@@ -650,7 +669,7 @@ def test_pendant_files_in_other_case_and_crlf(tmp_path: Path, pick: KrlResult) -
                 theirs.frame.number,
             )
             np.testing.assert_array_equal(target_values(ours), target_values(theirs))
-        elif isinstance(ours, ir.Verbatim) and isinstance(theirs, ir.Verbatim):
+        elif isinstance(ours, ir.Verbatim | ir.Comment) and isinstance(theirs, type(ours)):
             assert ours.text == theirs.text.swapcase()  # kept as written, in its own case
         else:
             assert dataclasses.replace(ours, span=theirs.span) == theirs

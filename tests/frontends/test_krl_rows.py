@@ -85,10 +85,15 @@ def test_a_long_program_reads_as_linear_paths_with_the_same_moves(
 ) -> None:
     dense, plain = both
     paths = [n for n in dense.program.instructions if isinstance(n, ir.LinearPath)]
-    # Split only where the IR changes: $ACC.CP (held once per path) at row 1666.
-    assert [len(p) for p in paths] == [1667, 3338]
-    assert all(isinstance(n, ir.LinearMove | ir.JointMove) for n in plain.program.instructions)
-    assert len(dense.program) == len(plain.program) == 5006
+    # Split only where the IR changes: $ACC.CP (held once per path) at row 1666, and the
+    # comment half way, kept in place (issue 15).
+    assert [len(p) for p in paths] == [1667, 835, 2503]
+    comments = [n for n in plain.program.instructions if isinstance(n, ir.Comment)]
+    assert [(c.text, c.span.line) for c in comments] == [("half way", 2514)]
+    assert all(
+        isinstance(n, ir.LinearMove | ir.JointMove | ir.Comment) for n in plain.program.instructions
+    )
+    assert len(dense.program) == len(plain.program) == 5007
     assert list(dense.program) == list(plain.program)
     assert dense.ignored == plain.ignored and dense.notes == plain.notes
 
@@ -117,7 +122,14 @@ def test_the_grammar_path_reads_the_same_linear_paths(monkeypatch: pytest.Monkey
     text = helix_program(300)
     fast = read(text, monkeypatch, dense=True)
     assert read(text, monkeypatch, dense=True, fast=False) == fast
-    assert kinds(fast) == [("JointMove", 1), ("LinearPath", 100), ("LinearPath", 200)]
+    # the comment half way stays in place: 50 rows before it are too few for a LinearPath
+    assert kinds(fast) == [
+        ("JointMove", 1),
+        ("LinearPath", 100),
+        *[("LinearMove", 1)] * 50,
+        ("Comment", 1),
+        ("LinearPath", 150),
+    ]
 
 
 def test_short_runs_stay_moves(monkeypatch: pytest.MonkeyPatch) -> None:

@@ -57,7 +57,7 @@ def test_krl_arcs_through_rapid_reach_the_same_tcp_samples() -> None:
     assert result.files, [d.format() for d in result.diagnostics]
     (mod,) = result.files.values()
     original = result.compiled
-    first = original.steps[0]
+    first = next(iter(original.motion_steps()))  # (the source's comments come first)
     start = ir.JointMove(target=ir.JointTarget(joints=first.joints))
     robot = station.robot
     back = resolve(_program_from_rapid(mod, robot.base @ robot.controller_base, start), station)

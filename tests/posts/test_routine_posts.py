@@ -20,6 +20,7 @@ import olp
 from olp import ir
 from olp.frontends.krl import load_krl
 from olp.ir_flow import leaves_and_blocks
+from tests.krl_round_trip import comment_lines, keeps_in_order, statements
 
 REPO = Path(__file__).resolve().parents[2]
 ROUTINES = REPO / "tests" / "routines"
@@ -52,7 +53,7 @@ def golden(post: str, files: dict[str, str]) -> None:
 def shape(nodes: Any) -> list[str]:
     """Statements and blocks in order, declarations apart; kept lines by their text."""
     out = []
-    for node in leaves_and_blocks(nodes):
+    for node in statements(leaves_and_blocks(nodes)):  # comments apart: comment_lines
         if isinstance(node, ir.Verbatim):
             out.append(node.text.upper().replace(" ", ""))
         elif node.kind != "declare":
@@ -82,7 +83,8 @@ def test_krl_to_krl_keeps_every_statement_of_every_routine(station: Any, tmp_pat
     assert [signature(r) for r in again.routines] == [signature(r) for r in source.routines]
     for ours, theirs in zip(again.routines, source.routines, strict=True):
         assert shape(ours.body) == shape(theirs.body), ours.name
-    counted = sum(len(list(leaves_and_blocks(r.body))) for r in source.routines)
+    assert keeps_in_order(comment_lines(again), comment_lines(source))
+    counted = sum(len(statements(leaves_and_blocks(r.body))) for r in source.routines)
     assert counted == 21  # the routines hold statements: the comparison above is not empty
     assert len(list(again.expanded().motions())) == len(list(source.expanded().motions()))
 

@@ -9,6 +9,10 @@ motion state) -> IR. Data lists (the module's ``.dat``, a ``$config.dat``) are r
 
 What is lowered
 ---------------
+* **Comments.** Every comment and pendant fold line is kept in place as
+  :class:`olp.ir.Comment` (``fold`` for ``;FOLD``/``;ENDFOLD``, as written), at every level
+  (:mod:`~olp.frontends.krl.comments`); the pendant's ``$BWDSTART`` and the lines of the
+  source's INI fold are kept for the KRL post alone (:mod:`~olp.frontends.krl.native`).
 * **Files.** ``&`` header lines, several ``DEF``/``DEFFCT`` routines, ``;FOLD`` comments. The
   first ``DEF`` is the program (a module of ``DEFFCT`` functions only is an empty program
   holding the functions as routines). Declarations may leave out ``DECL`` for the simple and the
@@ -82,17 +86,17 @@ What is lowered
   the reference ``Tool(name="TOOL_DATA[n]", number=n, pose=None)`` the station resolves by
   number. ``$NULLFRAME`` and number 0 -> :data:`olp.ir.WORLD`/:data:`olp.ir.FLANGE`.
 * **Inline forms (KUKATPBASIS, KSS 8).** The ``;FOLD PTP P1 Vel=100 % PDAT1 Tool[1] Base[0]``
-  comment is a comment; the lines inside it are lowered: ``PDAT_ACT=PPDAT1``/``LDAT_ACT=...``/
-  ``FDAT_ACT=FP1`` (assignments), ``BAS(#PTP_PARAMS, v)`` (FDAT_ACT's TOOL_NO, BASE_NO,
-  IPO_FRAME; joint speed ``v`` %, PDAT_ACT's ACC % and APO_DIST mm), ``BAS(#CP_PARAMS, v)``
-  (frames; ``$VEL.CP = v`` m/s, LDAT_ACT's APO_DIST mm), ``$H_POS=XHOME`` (also kept as
-  written: the controller's home for its ``$IN_HOME`` output), the motion.
-  ``BAS(#FRAMES|#PTP_DAT|#CP_DAT|#VEL_CP|#VEL_PTP|#ACC_PTP|#TOOL|#BASE, ...)`` likewise.
-  The spline inline forms' ``WITH $VEL_AXIS[1] = SVEL_JOINT(100.0), $TOOL = STOOL2(FP1),
-  $BASE = SBASE(FP1.BASE_NO), $APO = SAPO_PTP(PPDAT1), ...`` are read, for that motion only.
-  This follows KUKA's documented meaning of BAS and the inline forms; it is not verified
-  against ``BAS.SRC`` or a controller (which of the BAS value and PDAT VEL wins, and whether
-  WITH values outlast their motion, are the main open questions).
+  comment is a fold comment, kept; the lines inside it are lowered: ``PDAT_ACT=PPDAT1``/
+  ``LDAT_ACT=...``/``FDAT_ACT=FP1`` (assignments), ``BAS(#PTP_PARAMS, v)`` (FDAT_ACT's TOOL_NO,
+  BASE_NO, IPO_FRAME; joint speed ``v`` %, PDAT_ACT's ACC % and APO_DIST mm), ``BAS(#CP_PARAMS, v)``
+  (frames; ``$VEL.CP = v`` m/s, LDAT_ACT's APO_DIST mm), ``$H_POS=XHOME`` (also kept as written: the
+  controller's home for its ``$IN_HOME`` output), the motion.
+  ``BAS(#FRAMES|#PTP_DAT|#CP_DAT|#VEL_CP|#VEL_PTP|#ACC_PTP|#TOOL|#BASE, ...)`` likewise. The spline
+  inline forms' ``WITH $VEL_AXIS[1] = SVEL_JOINT(100.0), $TOOL = STOOL2(FP1), $BASE =
+  SBASE(FP1.BASE_NO), $APO = SAPO_PTP(PPDAT1), ...`` are read, for that motion only. This follows
+  KUKA's documented meaning of BAS and the inline forms; it is not verified against ``BAS.SRC`` or a
+  controller (which of the BAS value and PDAT VEL wins, and whether WITH values outlast their
+  motion, are the main open questions).
 * **Routines and calls.** The module's other ``DEF``/``DEFFCT`` routines are
   :class:`~olp.ir.Routine`\\ s of the program (:attr:`olp.ir.Program.routines`): parameters
   with their direction (``:IN`` by value, ``:OUT`` or no mark by reference) and the type their

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import TypeAlias
+from typing import Literal, TypeAlias
 
 import numpy as np
 
@@ -403,6 +403,18 @@ class Trigger:
     span: ir.SourceSpan
 
 
+@dataclass(frozen=True, slots=True)
+class CommentStmt:
+    """A comment of the source, in place among the statements (:mod:`olp.frontends.krl.comments`):
+    a line of its own (``; text``), a fold line (``;FOLD ...``, ``;ENDFOLD ...``: ``fold`` is
+    ``"open"`` or ``"close"``), or the end of a statement's line (after that statement).
+    ``text`` is what follows the ``;``: as written for a fold line, stripped otherwise."""
+
+    text: str
+    fold: Literal["open", "close"] | None
+    span: ir.SourceSpan
+
+
 Stmt: TypeAlias = (
     Assign
     | CallStmt
@@ -419,6 +431,7 @@ Stmt: TypeAlias = (
     | InterruptCtl
     | Trigger
     | Other
+    | CommentStmt
 )
 
 

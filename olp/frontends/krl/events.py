@@ -8,8 +8,10 @@ that is not a call, ``DISTANCE`` other than 0 or 1) is kept as :class:`olp.ir.Ve
 KUKA post writes it back, other posts stop on its line.
 
 The pendant's standard INI pair ``GLOBAL INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )``
-/ ``INTERRUPT ON 3`` stays out of the program, as before: the KUKA post writes that pair in the
-INI fold of every program it makes, so keeping it would declare interrupt 3 twice.
+/ ``INTERRUPT ON 3`` stays out of the program: the KUKA post writes that pair in the INI fold of
+every program it makes, so keeping it would declare interrupt 3 twice. Inside the source's own
+INI fold it is kept for the KRL post alone (:mod:`olp.frontends.krl.native`), which then writes
+the source's INI instead of its own.
 """
 
 from __future__ import annotations
@@ -32,7 +34,7 @@ from olp.frontends.krl.flow import to_expr
 from olp.frontends.krl.state import Core
 from olp.frontends.krl.values import Unknown
 
-_STANDARD_STOP = "the pendant's standard stop-message interrupt: the KUKA post writes it in the INI"
+STANDARD_STOP = "the pendant's standard stop-message interrupt: the KUKA post writes it in the INI"
 MM, MS = 1e-3, 1e-3
 
 
@@ -47,9 +49,9 @@ class Events(Core):
         return converted
 
     def _interrupt_decl(self, stmt: InterruptDecl) -> None:
-        if _is_standard_stop(stmt):
+        if is_standard_stop(stmt):
             self.stop_interrupt_declared = True
-            self._ignore(stmt, _STANDARD_STOP)
+            self._ignore(stmt, STANDARD_STOP)
             return
         if not isinstance(stmt.action, CallStmt):
             self._keep(stmt, "an interrupt's handler must be a subprogram call")
@@ -72,7 +74,7 @@ class Events(Core):
         standard_on = stmt.action == "ON" and _is_number(stmt.priority, 3)
         if standard_on and self.stop_interrupt_declared:
             self.stop_interrupt_declared = False
-            self._ignore(stmt, _STANDARD_STOP)
+            self._ignore(stmt, STANDARD_STOP)
             return
         priority = None
         if stmt.priority is not None:
@@ -133,7 +135,7 @@ class Events(Core):
         return ir.FunctionCall(name=call.name, args=args, span=call.span)
 
 
-def _is_standard_stop(stmt: InterruptDecl) -> bool:
+def is_standard_stop(stmt: InterruptDecl) -> bool:
     action, cond = stmt.action, stmt.condition
     handler = isinstance(action, CallStmt) and action.name.upper() == "IR_STOPM" and not action.args
     condition = (

@@ -180,6 +180,8 @@ def reads_name(nodes: Sequence[Any], name: str) -> bool:
     pending: list[Any] = list(nodes)
     while pending:
         node = pending.pop()
+        if isinstance(node, ir.Comment):  # a remark, not a statement: it reads nothing
+            continue
         if isinstance(node, ir.Name):
             if node.name.upper() == name.upper():
                 return True

@@ -20,6 +20,7 @@ from olp.frontends.krl.ast import (
     Expr,
     FuncCall,
 )
+from olp.frontends.krl.native import INITMOV
 from olp.frontends.krl.state import (
     KRL_ONLY_SYSTEM_VARIABLES,
     SYSTEM_REASONS,
@@ -140,9 +141,7 @@ class InlineForms(Core):
 
     def _bas_handlers(self) -> dict[str, Callable[[CallStmt], None]]:
         return {
-            "INITMOV": lambda s: self._ignore(
-                s, "BAS(#INITMOV) resets controller defaults; olp starts from its own"
-            ),
+            "INITMOV": lambda s: self._ignore(s, INITMOV),
             "ACC_CP": lambda s: self._ignore(
                 s, "BAS #ACC_CP is a percentage of the machine's path acceleration, unknown to olp"
             ),

@@ -23,6 +23,7 @@ from olp.frontends.krl.ast import (
     Binary,
     Block,
     CallStmt,
+    CommentStmt,
     DatBlock,
     Decl,
     Expr,
@@ -62,6 +63,7 @@ from olp.frontends.krl.flow import (
 )
 from olp.frontends.krl.module_data import with_module_data
 from olp.frontends.krl.motion import Motions
+from olp.frontends.krl.native import INI_TITLE, native_reason
 from olp.frontends.krl.routines import PendingCall, assemble, moves, typed_params
 from olp.frontends.krl.rows import build_instructions
 from olp.frontends.krl.state import (
@@ -163,6 +165,7 @@ class _Lowering(Motions, Events):
         # statements that set motion settings (absorbed into the motions) since the last motion
         self.unwritten: list[Stmt] = []
         self.unwritten_at: list[tuple[list[Any], int]] = []  # each one's output list, position
+        self.folds: list[str] = []  # the titles of the source's folds open here, innermost last
         self._blocks: dict[str, Callable[[Block], None]] = {
             "IF": self._if,
             "SWITCH": self._switch,
@@ -208,6 +211,9 @@ class _Lowering(Motions, Events):
             self.lower_statement(stmt)
 
     def lower_statement(self, stmt: Stmt) -> None:
+        if isinstance(stmt, CommentStmt):  # in place, reached or not: it says nothing to run
+            self._comment(stmt)
+            return
         if isinstance(stmt, LinRows):  # checks and spends per row itself
             self._lin_rows(stmt)
             self.unwritten.clear()
@@ -239,6 +245,8 @@ class _Lowering(Motions, Events):
                     hint="set them again before the motion (the pendant's inline forms do)",
                 )
         self.ctx.spend(stmt)
+        if self._kept_native(stmt):
+            return
         past = self._past_counters(stmt)
         start, reported = len(self.out), len(self.ignored)
         try:
@@ -248,6 +256,29 @@ class _Lowering(Motions, Events):
         if past:
             self._no_read_past_for(past, start, stmt)
         self._track_settings(stmt, self.out[start:], len(self.ignored) > reported)
+
+    def _comment(self, stmt: CommentStmt) -> None:
+        """A source comment, as :class:`olp.ir.Comment` (a fold line as such); the folds open
+        here are tracked, for the INI fold (:mod:`olp.frontends.krl.native`)."""
+        comment = ir.Comment(text=stmt.text, span=stmt.span, fold=stmt.fold, from_source=True)
+        if stmt.fold == "open":
+            self.folds.append(comment.title.upper())
+        elif stmt.fold == "close" and self.folds:
+            self.folds.pop()
+        self.out.append(comment)
+
+    def _kept_native(self, stmt: Stmt) -> bool:
+        """Keep a statement that matters only on a KUKA controller as a native-only
+        :class:`olp.ir.Verbatim` (:mod:`olp.frontends.krl.native`); False for any other."""
+        in_ini = INI_TITLE in self.folds and self.motion_count == 0
+        reason = native_reason(stmt, in_ini)
+        if reason is None:
+            return False
+        self._keep(stmt, reason)
+        kept = self.out[-1]
+        assert isinstance(kept, ir.Verbatim)
+        self.out[-1] = dataclasses.replace(kept, native_only=True)
+        return True
 
     def _past_counters(self, stmt: Stmt) -> dict[str, PastFor]:
         """The counters of unrolled FOR loops that hold their value after the loop here
@@ -674,6 +705,7 @@ class _Lowering(Motions, Events):
         child.return_ends = [] if probe else self.return_ends
         child.past = self.past
         child.in_block = self.in_block + 1
+        child.folds = list(self.folds)
         if not probe:
             child.ignored, child.notes, child.status_turn = (
                 self.ignored,

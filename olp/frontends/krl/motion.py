@@ -516,8 +516,8 @@ class Motions(InlineForms):
     def _previous_settings(self, fields: dict[str, Any], joint: bool) -> str | None:
         """Why the settings in ``fields`` may not be on the controller here, else None."""
         for node in reversed(self.out):
-            if isinstance(node, ir.Verbatim) and _is_motion_text(node.text):
-                continue  # a motion kept before, already checked: it changes no setting
+            if isinstance(node, ir.Verbatim) and (node.native_only or _is_motion_text(node.text)):
+                continue  # a motion kept before, already checked, or $BWDSTART: no setting
             if isinstance(node, Pending):
                 made, got = node.make, node.fields
             elif isinstance(node, PendingRows):  # plain LINs: the last row is the one before

@@ -68,6 +68,7 @@ from olp.frontends.krl.ast import (
     WaitFor,
     WaitSec,
 )
+from olp.frontends.krl.comments import attach
 from olp.frontends.krl.fast import RowReader, row_match, scan_line, signed_number
 from olp.resources import data_path
 
@@ -510,7 +511,13 @@ def parse_module(source: Source, fast: bool = True) -> Module:
     """The AST of ``source``; :class:`ParseError` (located) for text the grammar rejects.
 
     ``fast=False`` gives every line to lark (the reference the fast path is tested against).
+    The source's comments are statements of the module, in place
+    (:func:`olp.frontends.krl.comments.attach`).
     """
+    return attach(_parse_module(source, fast), source)
+
+
+def _parse_module(source: Source, fast: bool) -> Module:
     if fast and _FAST_RUN not in source.text:
         text, runs = _substitute_fast_runs(source)
         if runs:

@@ -484,19 +484,20 @@ class Core:
     def _keep_krl_only(self, stmt: Stmt | Assign, reason: str) -> None:
         """Keep a statement that only means something on a KUKA controller (an ``EXT``
         declaration, payload data, code a GOTO jumps over): the KRL post writes it back; to
-        another post it is harmless to leave out, with a warning giving ``reason``.
-
-        The IR's mark for that is not in this branch: until it is, this keeps a plain
-        :class:`~olp.ir.Verbatim` (other posts stop on it, as on any kept statement)."""
+        another post it is harmless to leave out, with a warning giving ``reason``
+        (:attr:`olp.ir.Verbatim.native_only`)."""
         self._keep_text(code_of(self.sources.snippet(stmt.span)), stmt.span, reason, True)
 
     def _keep_text(
         self, text: str, span: ir.SourceSpan, reason: str, krl_only: bool = False
     ) -> None:
         """Keep ``text`` (one statement of the source at ``span``) as written; ``krl_only``:
-        it only means something on a KUKA controller (not marked in the IR yet)."""
+        it only means something on a KUKA controller (other posts leave it out with a warning:
+        :attr:`olp.ir.Verbatim.native_only`)."""
         try:
-            kept = ir.Verbatim(text=text, language="krl", reason=reason, span=span)
+            kept = ir.Verbatim(
+                text=text, language="krl", reason=reason, span=span, native_only=krl_only
+            )
         except ir.FlowError as exc:  # a control character (a lone carriage return) inside it
             raise self._error(
                 f"olp keeps this statement as written, but it is not one clean line: {exc}",

@@ -215,7 +215,8 @@ class Known:
         """Forget what a call may change: everything but the program's local variables, and
         the variables passed to it; a verbatim statement may change anything."""
         if isinstance(call, f.Verbatim):
-            self.values.clear()
+            if not call.native_only:  # (a native-only one changes no variable)
+                self.values.clear()
             return
         self.values = {k: v for k, v in self.values.items() if _root(k) in self.local}
         for name in _argument_names(call):

@@ -17,6 +17,9 @@ MODULE flow_branches
     VAR string sState;
     ConfJ \On;
     ConfL \On;
+    ! Branches, a TEST-like SWITCH, variables and a wait on a condition, in the style of pick cells;
+    ! written for olp's post tests (issue 15): built for the abb and ur posts on the KR 6 cell.
+    ! INI
     MoveAbsJ p1\NoEOffs, v300, fine, spindle;
     nGood := 0;
     rLoad := 0.0;

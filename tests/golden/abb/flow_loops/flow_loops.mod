@@ -18,6 +18,9 @@ MODULE flow_loops
     VAR bool olp_done_1;
     ConfJ \On;
     ConfL \On;
+    ! WHILE, FOR with a count known only at run time, and REPEAT ... UNTIL around motions, in the
+    ! style of palletising cells; written for olp's post tests (issue 15).
+    ! INI
     MoveAbsJ p1\NoEOffs, v300, fine, spindle;
     nDone := 0;
     rZ := 300.0;

@@ -15,6 +15,9 @@ MODULE PickIrb120
   PROC main()
     ConfJ \On;
     ConfL \On;
+    ! Pick a puck from the tray, place it on the conveyor plate (stations/abb_irb120_pick_cell.yaml):
+    ! the ABB post's golden program and the second cell of the transpiling test. Tool 1 is the
+    ! suction cup; base 1 the tray, base 2 the conveyor (numbers from the station).
     MoveAbsJ p1\NoEOffs, v2000, fine, suction;
     MoveJ p2, v500, z10, suction\WObj:=tray;
     MoveL p3, v500, fine, suction\WObj:=tray;

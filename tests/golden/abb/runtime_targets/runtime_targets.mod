@@ -12,6 +12,7 @@ MODULE runtime_targets
     VAR robtarget xPath{3};
     ConfJ \On;
     ConfL \On;
+    ! motions to targets known only at run time: a path taught into an array elsewhere
     MoveAbsJ p1\NoEOffs, v200, fine, spindle;
     MoveL p2, v200, fine, spindle\WObj:=table;
     i := 1;

@@ -25,6 +25,9 @@ MODULE weld_rounded
   PROC main()
     ConfJ \On;
     ConfL \On;
+    ! A fillet weld around a rectangular plate, 200 x 120 mm with corners rounded to 20 mm: four
+    ! straight seams joined by quarter circles (CIRC aux, end), blended at every junction, with a
+    ! 150 mm torch tilted 20 degrees sideways (off the wrist singularity of a vertical torch).
     MoveJ p1, v200, fine, tool_l5\WObj:=world;
     MoveL p2, v200, fine, tool_l5\WObj:=world;
     MoveL p3, v200, fine, tool_l5\WObj:=world;

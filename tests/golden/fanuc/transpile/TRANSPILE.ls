@@ -5,7 +5,7 @@ COMMENT		= "";
 PROG_SIZE	= 0;
 FILE_NAME	= ;
 VERSION		= 0;
-LINE_COUNT	= 15;
+LINE_COUNT	= 21;
 MEMORY_SIZE	= 0;
 PROTECT		= READ_WRITE;
 TCD:  STACK_SIZE	= 0,
@@ -17,21 +17,27 @@ TCD:  STACK_SIZE	= 0,
 DEFAULT_GROUP	= 1,*,*,*,*;
 CONTROL_CODE	= 00000000 00000000;
 /MN
-   1:  UFRAME_NUM=0 ;
-   2:  UTOOL_NUM=1 ;
-   3:J P[1] 100% FINE    ;
-   4:L P[2] 250mm/sec FINE    ;
-   5:  DO[1]=ON ;
-   6:  WAIT 0.50(sec) ;
-   7:L P[3] 50mm/sec CNT20    ;
-   8:L P[4] 50mm/sec CNT20    ;
-   9:L P[5] 50mm/sec CNT20    ;
-  10:L P[6] 50mm/sec CNT20    ;
-  11:L P[7] 50mm/sec FINE    ;
-  12:  DO[1]=OFF ;
-  13:  WAIT DI[2]=ON ;
-  14:L P[8] 250mm/sec CNT20    ;
-  15:J P[9] 100% FINE    ;
+   1:  !A KRL program that runs on both ;
+   2:  !the UR5e screwdriving cell and ;
+   3:  !the Fanuc M-20iA welding cell ;
+   4:  !(tool 1 of each station, a base ;
+   5:  !frame in front of both robots): ;
+   6:  !the transpiling goldens. ;
+   7:  UFRAME_NUM=0 ;
+   8:  UTOOL_NUM=1 ;
+   9:J P[1] 100% FINE    ;
+  10:L P[2] 250mm/sec FINE    ;
+  11:  DO[1]=ON ;
+  12:  WAIT 0.50(sec) ;
+  13:L P[3] 50mm/sec CNT20    ;
+  14:L P[4] 50mm/sec CNT20    ;
+  15:L P[5] 50mm/sec CNT20    ;
+  16:L P[6] 50mm/sec CNT20    ;
+  17:L P[7] 50mm/sec FINE    ;
+  18:  DO[1]=OFF ;
+  19:  WAIT DI[2]=ON ;
+  20:L P[8] 250mm/sec CNT20    ;
+  21:J P[9] 100% FINE    ;
 /POS
 P[1]{
    GP1:

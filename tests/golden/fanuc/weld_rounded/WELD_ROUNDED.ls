@@ -5,7 +5,7 @@ COMMENT		= "";
 PROG_SIZE	= 0;
 FILE_NAME	= ;
 VERSION		= 0;
-LINE_COUNT	= 17;
+LINE_COUNT	= 28;
 MEMORY_SIZE	= 0;
 PROTECT		= READ_WRITE;
 TCD:  STACK_SIZE	= 0,
@@ -17,27 +17,38 @@ TCD:  STACK_SIZE	= 0,
 DEFAULT_GROUP	= 1,*,*,*,*;
 CONTROL_CODE	= 00000000 00000000;
 /MN
-   1:  UFRAME_NUM=0 ;
-   2:  UTOOL_NUM=1 ;
-   3:J P[1] 100% FINE    ;
-   4:L P[2] 200mm/sec FINE    ;
-   5:L P[3] 200mm/sec FINE    ;
-   6:  DO[2]=ON ;
-   7:L P[4] 12mm/sec CNT2    ;
-   8:C P[5]
+   1:  !A fillet weld around a ;
+   2:  !rectangular plate, 200 x 120 mm ;
+   3:  !with corners rounded to 20 mm: ;
+   4:  !four ;
+   5:  !straight seams joined by quarter ;
+   6:  !circles (CIRC aux, end), blended ;
+   7:  !at every junction, with a ;
+   8:  !150 mm torch tilted 20 degrees ;
+   9:  !sideways (off the wrist ;
+  10:  !singularity of a vertical ;
+  11:  !torch). ;
+  12:  UFRAME_NUM=0 ;
+  13:  UTOOL_NUM=1 ;
+  14:J P[1] 100% FINE    ;
+  15:L P[2] 200mm/sec FINE    ;
+  16:L P[3] 200mm/sec FINE    ;
+  17:  DO[2]=ON ;
+  18:L P[4] 12mm/sec CNT2    ;
+  19:C P[5]
     :  P[6] 12mm/sec CNT2    ;
-   9:L P[7] 12mm/sec CNT2    ;
-  10:C P[8]
+  20:L P[7] 12mm/sec CNT2    ;
+  21:C P[8]
     :  P[9] 12mm/sec CNT2    ;
-  11:L P[10] 12mm/sec CNT2    ;
-  12:C P[11]
+  22:L P[10] 12mm/sec CNT2    ;
+  23:C P[11]
     :  P[12] 12mm/sec CNT2    ;
-  13:L P[13] 12mm/sec CNT2    ;
-  14:C P[14]
+  24:L P[13] 12mm/sec CNT2    ;
+  25:C P[14]
     :  P[15] 12mm/sec FINE    ;
-  15:  DO[2]=OFF ;
-  16:L P[16] 200mm/sec FINE    ;
-  17:J P[17] 100% FINE    ;
+  26:  DO[2]=OFF ;
+  27:L P[16] 200mm/sec FINE    ;
+  28:J P[17] 100% FINE    ;
 /POS
 P[1]{
    GP1:

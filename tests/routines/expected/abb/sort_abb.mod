@@ -12,6 +12,8 @@ MODULE sort_abb
     VAR bool bDone;
     ConfJ \On;
     ConfL \On;
+    ! A sorting cell for olp's routine tests on the IRB 120: a helper DEF with an IN and an OUT
+    ! parameter, one that loops, and a DEFFCT returning BOOL.
     MoveAbsJ p1\NoEOffs, v2000, fine, tool0;
     nSorted := 0;
     Drop 2, nSorted;
