@@ -189,7 +189,9 @@ def reads_name(nodes: Sequence[Any], name: str) -> bool:
         elif isinstance(node, tuple | list):
             pending.extend(node)
         elif dataclasses.is_dataclass(node) and not isinstance(node, ir.SourceSpan):
-            pending.extend(getattr(node, f.name) for f in dataclasses.fields(node))
+            # a reason is olp's text, which may quote the program (``p.X + q.X``), not code
+            fields = (f.name for f in dataclasses.fields(node) if f.name != "reason")
+            pending.extend(getattr(node, name) for name in fields)
     return False
 
 

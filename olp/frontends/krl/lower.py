@@ -220,6 +220,7 @@ class _Lowering(Motions, Events):
         if self.jumped is not None and not (isinstance(stmt, Other) and stmt.kind == "label"):
             self._ignore(stmt, f"not reached: the GOTO at line {self.jumped} jumps away")
             return
+        self.check_declared(stmt)
         if self.ambiguous and isinstance(stmt, MotionStmt | FastMotion):
             motion = materialise(stmt) if isinstance(stmt, FastMotion) else stmt
             if self._controller_settings_motion(motion):
