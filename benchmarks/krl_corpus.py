@@ -37,6 +37,18 @@ zones, tools and bases (inline-form data, BAS, ``$VEL``/``$ACC``/``$TOOL``/``$BA
 written ``.src`` again and compares its statements with the source's, in order
 (``krl_round_trip_differs``: "KRL -> KRL keeps every statement" wants 0).
 
+With the KUKA post it also counts by text (:func:`count_text`): each statement of the source
+``.src`` (a line of code: not blank, not only a comment or a fold line, not an ``&`` header;
+DEF/DEFFCT/END/ENDFCT lines apart, ``routine_lines_*``) against the written ``.src``'s,
+matched by normalised text (upper case, blanks removed) as a multiset.
+``statements_text_found_krl``: written as read; ``statements_rewritten_krl``: olp lowered it
+and the post writes it in its own spelling (a motion to ``XP1`` as ``PTP {A1 ..}``, an
+expression with other parentheses, ``DECL INT a, b`` as two lines, and the inline forms'
+``PDAT_ACT=PPDAT1``, ``FDAT_ACT=FP1``, ``BAS(#PTP_PARAMS,100)``, which become the
+``$VEL_AXIS[i]``, ``$ACC_AXIS[i]``, ``$VEL.CP``, ``$APO.CDIS``, ``$TOOL`` and ``$BASE`` lines
+before the motion that runs with them); ``statements_lost_krl``: the rest, not in the output
+in any spelling (with ``-v``: the texts lost most often, and the rewritten ones by kind).
+
 The last lines are ``name: value unit``.
 """
 
@@ -85,6 +97,22 @@ class Tally:
     warned: int = 0
     unaccounted: list[str] = field(default_factory=list)
     round_trip_differs: list[str] = field(default_factory=list)
+    text: TextCount = field(default_factory=lambda: TextCount())
+
+
+@dataclass
+class TextCount:
+    """The source's statements against the written ``.src``'s, by text (see
+    :func:`count_text`): ``found`` in the output as written, ``rewritten`` (olp lowered the
+    statement, and the post writes it in its own spelling), ``lost``; ``routine_lines`` (DEF,
+    END, ...) apart. The counters of rewritten and lost statements are by normalised text."""
+
+    statements: int = 0
+    found: int = 0
+    rewritten: collections.Counter[str] = field(default_factory=collections.Counter)
+    lost: collections.Counter[str] = field(default_factory=collections.Counter)
+    routine_lines: int = 0
+    routine_lines_lost: collections.Counter[str] = field(default_factory=collections.Counter)
 
 
 def construct_of(message: str, source_line: str | None) -> str:
@@ -142,7 +170,8 @@ def account(text: str, src: str, result: object, tally: Tally) -> None:
         return runtime or is_motion(node)  # type: ignore[arg-type]
 
     lines = statement_lines(text)
-    kept = {n.span.line for n in leaves_and_blocks(program.instructions) if n.span.file == src}
+    nodes = [*program.params, *leaves_and_blocks(program.instructions)]
+    kept = {n.span.line for n in nodes if n.span.file == src}
     nodes = list(leaves_and_blocks(program.instructions))
     motions = [n.span.line for n in nodes if is_motion_with_settings(n) and n.span.file == src]
     for routine in program.routines:  # the module's routines the program keeps, written out too
@@ -181,6 +210,90 @@ def account(text: str, src: str, result: object, tally: Tally) -> None:
             tally.warned += 1
         else:
             tally.unaccounted.append(f"{src}:{number}: {line}")
+
+
+_ROUTINE_LINE = re.compile(r"(?i)((GLOBAL\s+)?(DEF|DEFFCT)\b|(END|ENDFCT)$)")
+_REWRITTEN = re.compile(
+    r"(?i)(BAS\s*\(|(PDAT_ACT|LDAT_ACT|FDAT_ACT)\s*=|\$(VEL|VEL_AXIS|ACC|ACC_AXIS|APO|TOOL|BASE|"
+    r"IPO_MODE|ORI_TYPE|CIRC_TYPE)\b)"
+)
+"""Statements olp absorbs into the motions' settings: the KUKA post writes ``$VEL_AXIS[i]``,
+``$ACC_AXIS[i]``, ``$VEL.CP``, ``$ACC.CP``, ``$APO.CDIS``, ``$TOOL``, ``$BASE`` (and
+``$ORI_TYPE``/``$CIRC_TYPE``) before the motion that runs with them instead of the inline
+forms' ``PDAT_ACT=PPDAT1``, ``FDAT_ACT=FP1`` and ``BAS(#PTP_PARAMS,100)``."""
+_MOTION = re.compile(r"(?i)(S?PTP|S?LIN|S?CIRC)(_REL)?\b")
+_CODE = re.compile(r"""([^;"']|"[^"]*"|'[^']*')*""")
+"""A line's code: up to a ``;`` outside a string or character constant."""
+
+
+def normalised(line: str) -> str:
+    """A statement's text as the count compares it: upper case, without blanks."""
+    return re.sub(r"\s+", "", line).upper()
+
+
+def text_statements(text: str) -> list[tuple[int, str]]:
+    """(line number, text without its comment) of each line of a ``.src`` that holds code:
+    not blank, not only a comment (fold lines are comments), not an ``&`` header."""
+    found = []
+    for number, raw in enumerate(text.splitlines(), start=1):
+        line = _CODE.match(raw).group(0).strip()  # type: ignore[union-attr]
+        if line and not line.startswith("&"):
+            found.append((number, line))
+    return found
+
+
+def lowered_lines(program: object, src: str) -> set[int]:
+    """The lines of ``src`` that an IR node other than a kept line carries (a motion, an
+    assignment, a block, the rows of a toolpath): the post writes them in its own spelling."""
+    from olp.ir_flow import leaves_and_blocks
+
+    nodes = list(leaves_and_blocks(program.instructions))  # type: ignore[attr-defined]
+    for routine in program.routines:  # type: ignore[attr-defined]
+        nodes.extend([*routine.params, *routine.declarations, *leaves_and_blocks(routine.body)])
+    lines: set[int] = set()
+    for node in nodes:
+        if getattr(node, "kind", "") == "verbatim" or node.span.file != src:
+            continue
+        rows = getattr(node, "lines", None)  # a toolpath's rows carry a line each
+        lines.update([node.span.line] if rows is None else (int(n) for n in rows))
+    return lines
+
+
+def count_text(text: str, src: str, result: object, count: TextCount) -> None:
+    """KRL -> KRL by text: each statement of the source ``.src`` is ``found`` when the written
+    ``.src`` holds a statement of the same normalised text (a multiset: each written statement
+    matches once), else ``rewritten`` when olp lowered it (:func:`lowered_lines`, motions,
+    :data:`_REWRITTEN`), else ``lost``. DEF/DEFFCT/END/ENDFCT lines are counted apart."""
+    written: collections.Counter[str] = collections.Counter()
+    files = result.files  # type: ignore[attr-defined]
+    for name in (n for n in files if n.lower().endswith(".src")):
+        written.update(normalised(line) for _, line in text_statements(files[name]))
+    lowered = lowered_lines(result.compiled.program, src)  # type: ignore[attr-defined]
+    for number, line in text_statements(text):
+        key = normalised(line)
+        routine = _ROUTINE_LINE.match(line) is not None
+        count.routine_lines += routine
+        count.statements += not routine
+        if written[key] > 0:
+            written[key] -= 1
+            count.found += not routine
+        elif routine:
+            count.routine_lines_lost[key] += 1
+        elif number in lowered or _REWRITTEN.match(line) or _MOTION.match(line):
+            count.rewritten[_kind(line)] += 1
+        else:
+            count.lost[key] += 1
+
+
+def _kind(line: str) -> str:
+    """What a rewritten statement is, for the listing: its first word (``PTP``, ``BAS``,
+    ``PDAT_ACT``, ``$VEL_AXIS``), or ``assignment`` / ``call`` for the rest."""
+    word = _WORD.match(line.strip())
+    first = word.group(0).upper() if word else line[:12]
+    rest = line.strip()[len(first) :].lstrip()
+    if first in _KEYWORDS or _STRUCTURE.match(first) or first.startswith("$") or "_ACT" in first:
+        return first
+    return "call" if rest.startswith("(") else "assignment"
 
 
 def find_config(folder: Path) -> Path | None:
@@ -282,6 +395,8 @@ def _one(olp, path, station, options, post, tally, olp_error) -> str:  # type: i
     text = path.read_text(encoding="latin-1")
     account(text, src, result, tally)
     if post == "kuka":
+        count_text(text, src, result, tally.text)
+    if post == "kuka":
         try:
             same = round_trips(result, options)
         except olp_error as exc:  # the written KRL does not read again: a fault of olp's
@@ -371,7 +486,26 @@ def main() -> None:
     for name in tally.round_trip_differs:
         print(f"  KRL -> KRL differs {name}")
     print(f"krl_round_trip_differs: {len(tally.round_trip_differs)} files")
+    print_text_count(tally.text, args.verbose)
     print(f"seconds: {seconds:.2f} s")
+
+
+def print_text_count(count: TextCount, verbose: bool) -> None:
+    """The figures of :func:`count_text` (with ``verbose``: the texts lost most often and
+    what was rewritten, by kind)."""
+    if verbose:
+        for kind, number in count.rewritten.most_common():
+            print(f"  rewritten {number} x {kind}")
+        for text, number in count.lost.most_common(40):
+            print(f"  lost {number} x {text[:100]}")
+        for text, number in count.routine_lines_lost.most_common(10):
+            print(f"  routine line lost {number} x {text[:100]}")
+    print(f"statements_text_in: {count.statements} statements")
+    print(f"statements_text_found_krl: {count.found} statements")
+    print(f"statements_rewritten_krl: {sum(count.rewritten.values())} statements")
+    print(f"statements_lost_krl: {sum(count.lost.values())} statements")
+    print(f"routine_lines_in: {count.routine_lines} lines")
+    print(f"routine_lines_lost_krl: {sum(count.routine_lines_lost.values())} lines")
 
 
 if __name__ == "__main__":

@@ -597,20 +597,34 @@ class Wait:
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class SetOutput:
-    """Set digital output ``index`` to ``value``."""
+    """Set digital output ``index`` to ``value``.
+
+    ``signal``: the name the program reads the bit by where it has one (a KRL
+    ``SIGNAL OutCinta $OUT[9]`` declared outside the program, in ``$config.dat``), so that
+    a post of that language writes the program as it was written; None: by number. The name
+    is only another spelling of ``index``: every other post, and every check, uses the number.
+    """
 
     index: int
     value: bool
+    signal: str | None = None
     span: SourceSpan = GENERATED
     kind: Literal["set_output"] = field(default="set_output", init=False)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class WaitInput:
-    """Wait until digital input ``index`` equals ``value``."""
+    """Wait until digital input ``index`` equals ``value``.
+
+    ``signal``: the name the program reads the bit by where it has one (a KRL
+    ``SIGNAL InTermicoCinta $IN[9]`` declared outside the program, in ``$config.dat``), so that
+    a post of that language writes the program as it was written; None: by number. The name
+    is only another spelling of ``index``: every other post, and every check, uses the number.
+    """
 
     index: int
     value: bool = True
+    signal: str | None = None
     span: SourceSpan = GENERATED
     kind: Literal["wait_input"] = field(default="wait_input", init=False)
 
@@ -826,18 +840,34 @@ class Program:
     give count every move of a toolpath as one instruction, as if the program held ordinary
     moves only; they walk the program's own body (a call is one instruction), while
     :meth:`expanded` walks into each call.
+
+    ``params``: the program's own parameters in call order (:class:`Parameter`, as a
+    routine's), for a program that other programs call with arguments (a KRL module
+    ``DEF MoveSettings(nBase:IN, nTool:IN)``). Their values are known only when the program
+    runs: what its body computes from them is run-time. A post writes them where its language
+    lets a program take arguments and refuses the program with a located error otherwise.
     """
 
     name: str
     instructions: tuple[Node, ...]
     source: str = "<memory>"
     routines: tuple[Routine, ...] = ()
+    params: tuple[Parameter, ...] = ()
 
     def __post_init__(self) -> None:
         if not isinstance(self.instructions, tuple):
             object.__setattr__(self, "instructions", tuple(self.instructions))
         if not isinstance(self.routines, tuple):
             object.__setattr__(self, "routines", tuple(self.routines))
+        if not isinstance(self.params, tuple):
+            object.__setattr__(self, "params", tuple(self.params))
+        names: set[str] = set()
+        for param in self.params:
+            if not isinstance(param, Parameter):
+                raise IRError(f"Program.params must hold Parameter objects, got {param!r}")
+            if param.name.casefold() in names:
+                raise IRError(f"Program {self.name}: parameter {param.name} is given twice")
+            names.add(param.name.casefold())
         seen: set[str] = set()
         for routine in self.routines:
             if not isinstance(routine, Routine):
@@ -876,8 +906,9 @@ class Program:
     @property
     def has_flow(self) -> bool:
         """Whether the program holds control flow or data statements (:mod:`olp.ir_flow`),
-        routines included."""
-        return bool(self.routines) or _flow.has_flow(self.instructions)
+        routines and parameters included (a program with parameters is never split into
+        parts: a part would not see them)."""
+        return bool(self.routines or self.params) or _flow.has_flow(self.instructions)
 
     def flat_nodes(self) -> tuple[Instruction | LinearPath, ...]:
         """The nodes in source order with blocks walked into: what the passes check, one step

@@ -126,9 +126,16 @@ class Member:
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class DigitalInput:
-    """The state of digital input ``index`` (KRL ``$IN[n]``)."""
+    """The state of digital input ``index`` (KRL ``$IN[n]``).
+
+    ``signal``: the name the program reads the bit by where it has one (a KRL
+    ``SIGNAL InTermicoCinta $IN[9]`` declared outside the program, in ``$config.dat``), so that
+    a post of that language writes the program as it was written; None: by number. The name
+    is only another spelling of ``index``: every other post, and every check, uses the number.
+    """
 
     index: int
+    signal: str | None = None
     span: SourceSpan = GENERATED
 
 

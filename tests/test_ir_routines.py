@@ -127,3 +127,15 @@ def test_editing_motions_reaches_the_routines() -> None:
     fewer = program().filter(lambda i: i.kind != "set_output")
     grip = fewer.routine("Grip")
     assert grip is not None and [n.kind for n in grip.body] == ["return"]
+
+
+def test_a_program_takes_typed_parameters_once_each() -> None:
+    """A program other programs call has parameters as a routine's (issue 15); they make it
+    a program with data (never split into parts, which would not see them)."""
+    slot = ir.Parameter(name="nSlot", type_name="INT")
+    called = ir.Program(name="SetGrip", instructions=[ir.Wait(seconds=0.1)], params=[slot])
+    assert called.params == (slot,) and called.has_flow
+    with pytest.raises(ir.IRError, match="parameter NSLOT is given twice"):
+        ir.Program(name="p", instructions=(), params=(slot, ir.Parameter(name="NSLOT")))
+    with pytest.raises(ir.IRError, match="must hold Parameter objects"):
+        ir.Program(name="p", instructions=(), params=("nSlot",))  # type: ignore[arg-type]

@@ -545,6 +545,12 @@ class AbbPost(Post):
     PREDEFINED_NAMES = PREDEFINED_NAMES
     WRITES_FLOW = True
     WRITES_ROUTINES = True
+    PROGRAM_PARAMS = (
+        "olp writes a program as the module's entry routine (PROC main, or the post option "
+        "entry), which the controller starts without arguments; a module that other modules "
+        "call with arguments would be a PROC with parameters (num p, INOUT num q) and no entry "
+        "routine, which olp does not write yet"
+    )
     KINDS: ClassVar[frozenset[str]] = Post.KINDS | {"runtime_move"}
     STREAMS = True
     STREAM_NEUTRAL_FILTERS = frozenset({"rapid_pad"})

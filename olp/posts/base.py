@@ -53,7 +53,7 @@ from numpy.typing import NDArray
 
 from olp.diagnostics import Diagnostic
 from olp.errors import PostError
-from olp.ir import ArcOrientation
+from olp.ir import ArcOrientation, Program
 from olp.posts.numbers import NumberError, NumberFormat, format_number, format_numbers
 from olp.posts.sandbox import PostSandbox, make_environment
 from olp.posts.text import (
@@ -149,6 +149,11 @@ class Post:
     writing its instructions in a row. So does a template folder whose ``post.yaml`` does not
     say ``flow: true`` (a copy made before olp wrote control flow would write each block's body
     unconditionally)."""
+    PROGRAM_PARAMS: ClassVar[str | None] = None
+    """Why this language's program cannot take the program's own parameters
+    (:attr:`olp.ir.Program.params`), for the located error on a program that has them; None:
+    the post writes them (with ``program_params: true`` in its manifest; a folder copied before
+    olp wrote them is refused the same way)."""
     VERBATIM: ClassVar[str | None] = None
     """The language of :class:`~olp.ir.Verbatim` statements this post writes unchanged (KUKA:
     ``"krl"``); a verbatim statement of another language is an error on its line."""
@@ -282,6 +287,28 @@ class Post:
         """Whether this post, with its template folder, writes routines as routines."""
         return self.WRITES_ROUTINES and self.manifest.routines
 
+    def writes_program_params(self) -> bool:
+        """Whether this post, with its template folder, writes the program's parameters."""
+        return self.PROGRAM_PARAMS is None and self.manifest.program_params
+
+    def _params_error(self, program: Program) -> Diagnostic:
+        names = ", ".join(p.name for p in program.params)
+        why = self.PROGRAM_PARAMS or (
+            f"the template folder {self.manifest.folder} does not say program_params: true (a "
+            "copy made before olp wrote them would write the program without them)"
+        )
+        message = (
+            f"program {program.name} takes parameters ({names}), which the {self.LANGUAGE} post "
+            f"does not write: {why}"
+        )
+        hint = (
+            "write it as a program without parameters for this controller (give them values "
+            "in its body), or build it for KRL"
+            if self.PROGRAM_PARAMS
+            else "update the folder from olp's bundled post and add program_params: true"
+        )
+        return Diagnostic("error", "program_params", message, program.params[0].span, hint=hint)
+
     def prepare(self, compiled: CompiledProgram) -> tuple[CompiledProgram, list[Diagnostic]]:
         """Write routines out at their calls where the post does not write routines
         (:func:`olp.posts.routines.written_out`), then apply the ``TRANSFORMS`` in order."""
@@ -298,6 +325,8 @@ class Post:
     def check(self, compiled: CompiledProgram) -> list[Diagnostic]:
         """Everything this post reports about ``compiled``; errors mean nothing is written."""
         out = self._foreign_robot(compiled)
+        if compiled.program.params and not self.writes_program_params():
+            out.append(self._params_error(compiled.program))
         if compiled.program.has_flow and not (self.WRITES_FLOW and self.manifest.flow):
             return [*out, self._flow_error(compiled)]
         from olp.compiled import PathBlock, items_of

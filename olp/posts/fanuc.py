@@ -611,6 +611,11 @@ class FanucPost(Post):
     WRITES_FLOW = True
     STREAMS = True
     STREAM_PARTS = True
+    PROGRAM_PARAMS = (
+        "a TP program called with arguments reads them as AR[1], AR[2], ... (numbers and "
+        "strings, by value), and olp has no Fanuc document at hand to cite for how an LS "
+        "program declares and reads them, so it does not write them"
+    )
     ONCE_PER_PROGRAM = frozenset({"controller_frame", "controller_tool"})
     NAME_RULE = NAME_RULE
     COMMENTS = CommentRule(max_length=COMMENT_LENGTH, replace=((";", ","),), collapse=True)

@@ -57,7 +57,7 @@ from numpy.typing import ArrayLike, NDArray
 from olp.diagnostics import Diagnostic
 from olp.errors import PostError
 from olp.ir import ArcOrientation, CartesianTarget
-from olp.ir_flow import FLOW_TYPES, Declare, leaves_and_blocks
+from olp.ir_flow import FLOW_TYPES, Declare, Routine, leaves_and_blocks
 from olp.posts.base import Filter, Post
 from olp.posts.kuka_flow import (
     EVENT_KINDS,
@@ -65,9 +65,13 @@ from olp.posts.kuka_flow import (
     flow_problem,
     krl_call,
     krl_decl,
+    krl_declaration,
+    krl_declarations,
     krl_event,
     krl_expr,
+    krl_io,
     krl_param_decl,
+    krl_program_head,
     krl_return,
     krl_routine_end,
     krl_routine_head,
@@ -439,8 +443,12 @@ FILTERS: Mapping[str, Filter] = {
     "krl_rows_dat": krl_rows_dat,
     "krl_expr": lambda post, expr: krl_expr(expr),
     "krl_decl": lambda post, step: krl_decl(step),
+    "krl_declaration": lambda post, step: krl_declaration(step),
+    "krl_declarations": lambda post, steps: krl_declarations(steps),
     "krl_event": lambda post, node: krl_event(node),
     "krl_routine_head": lambda post, routine: krl_routine_head(routine),
+    "krl_io": lambda post, node, io: krl_io(node, io),
+    "krl_program_head": lambda post, program: krl_program_head(program["name"], program["params"]),
     "krl_routine_end": lambda post, routine: krl_routine_end(routine),
     "krl_param_decl": lambda post, param: krl_param_decl(param),
     "krl_call": lambda post, call: krl_call(call),
@@ -543,6 +551,10 @@ class KukaPost(Post):
                 if (message, node.span) not in seen:
                     seen.add((message, node.span))
                     found.append(Diagnostic("error", "flow", message, node.span))
+        head = Routine(name=program.name, params=program.params)
+        if program.params and (problem := routine_problem(head)) is not None:
+            message = f"program {program.name} cannot be written in KRL: {problem}"
+            found.append(Diagnostic("error", "flow", message, program.params[0].span))
         for routine in program.routines:
             if (problem := routine_problem(routine)) is not None:
                 message = f"routine {routine.name} cannot be written in KRL: {problem}"

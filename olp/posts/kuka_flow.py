@@ -5,7 +5,8 @@ Operators: ``and``/``or``/``xor``/``not`` -> ``AND``/``OR``/``EXOR``/``NOT``; ``
 they are. Every nested binary operation is parenthesised, so the meaning never depends on
 KRL's priorities (the source's own parentheses are not kept). Constants: ``TRUE``/``FALSE``,
 integers, reals (Python's shortest round-trip form, locale-independent), strings in double
-quotes, enumeration values as ``#NAME``; ``DigitalInput(n)`` is ``$IN[n]``.
+quotes, enumeration values as ``#NAME``; ``DigitalInput(n)`` is ``$IN[n]``, or the SIGNAL
+name the program read it by (:func:`krl_io`).
 
 User text is never code: names must be KRL identifiers and strings may not hold a double quote
 or a control character (:func:`flow_problem` says what cannot be written; the post reports it on
@@ -16,6 +17,7 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Sequence
 from typing import Any
 
 from olp import ir
@@ -52,7 +54,7 @@ def krl_expr(expr: ir.Expr | None, nested: bool = False) -> str:
     if isinstance(expr, ir.Member):
         return f"{krl_expr(expr.base)}.{expr.field}"
     if isinstance(expr, ir.DigitalInput):
-        return f"$IN[{expr.index}]"
+        return krl_io(expr, "$IN")
     if isinstance(expr, ir.FunctionCall):
         return f"{expr.name}({', '.join(krl_expr(a) for a in expr.args)})"
     if isinstance(expr, ir.UnaryOp):
@@ -97,6 +99,33 @@ def krl_decl(step: Any) -> str:
     return SafeText("\n".join(lines))
 
 
+_DECLARATION = re.compile(r"(?i)\s*(GLOBAL\s+)?(EXT|EXTFCT)\s")
+
+
+def krl_declaration(step: Any) -> bool:
+    """Whether ``step`` is a kept KRL line that declares (``EXT name( )``, ``EXTFCT INT
+    f( )``): KRL takes those only in a routine's declaration part, before its first
+    statement, so the templates write them with the ``DECL`` lines, not in the flow."""
+    node = getattr(step, "instruction", step)
+    return (
+        isinstance(node, ir.Verbatim)
+        and node.language == "krl"
+        and _DECLARATION.match(node.text) is not None
+    )
+
+
+def krl_declarations(steps: Any) -> list[str]:
+    """The texts of the kept declaration lines among ``steps`` (:func:`krl_declaration`), each
+    once (a routine written out at each of its calls brings its EXT lines each time), in
+    order."""
+    texts: dict[str, str] = {}
+    for step in steps:
+        if krl_declaration(step):
+            text = step.instruction.text
+            texts.setdefault(re.sub(r"\s+", "", text).upper(), text)
+    return list(texts.values())
+
+
 def krl_routine_head(routine: ir.Routine) -> str:
     """``[GLOBAL] DEF name(p:IN, q:OUT)`` or ``[GLOBAL] DEFFCT TYPE[dims] name(...)``: an
     ``"in"`` parameter is KRL's ``:IN`` (by value), an ``"out"`` one ``:OUT`` (by reference);
@@ -114,6 +143,28 @@ def krl_routine_head(routine: ir.Routine) -> str:
         f"[{','.join(krl_expr(d) for d in routine.returns_dims)}]" if routine.returns_dims else ""
     )
     return f"{prefix}DEFFCT {routine.returns}{dims} {routine.name}({params})"
+
+
+def krl_io(node: ir.DigitalInput | ir.SetOutput | ir.WaitInput, io: str) -> str:
+    """A digital input or output as the program read it: its SIGNAL name where it had one
+    (``InTermicoCinta``, declared in ``$config.dat``: KRL -> KRL writes what the user wrote),
+    else ``$IN[n]`` / ``$OUT[n]`` (``io``). A name that is not a plain KRL name (an IR made
+    elsewhere) is written by its number, which reads the same bit."""
+    name = node.signal
+    if name is not None and _IDENTIFIER.match(name) and not name.startswith("$"):
+        return name
+    return f"{io}[{node.index}]"
+
+
+def krl_program_head(name: str, params: Sequence[ir.Parameter]) -> str:
+    """The program's ``DEF``: ``DEF name( )`` as the pendant writes a program without
+    parameters, ``DEF name(p:IN, q:OUT)`` for one that other modules call with arguments
+    (:attr:`olp.ir.Program.params`, written as a routine's, :func:`krl_routine_head`; their
+    types are declared first in the body, :func:`krl_param_decl`). The module's first DEF is
+    the one other modules call by the module's name, so it needs no ``GLOBAL``."""
+    if not params:
+        return f"DEF {name}( )"
+    return krl_routine_head(ir.Routine(name=name, params=tuple(params)))
 
 
 def _empty_index(dims: tuple[object, ...]) -> str:

@@ -34,6 +34,10 @@ The manifest says::
                                       # data in the data list, external names not declared);
                                       # default false: a folder copied before, which a post
                                       # that checks it refuses for a program with module data
+    program_params: true              # the templates write the program's own parameters
+                                      # (olp.ir.Program.params; default false: a folder copied
+                                      # before would write the program without them, so the
+                                      # post refuses a program that has them)
     runtime_targets: true             # the templates write motions to run-time targets
                                       # (kind runtime_move; default false: a folder copied
                                       # before would leave them out, so the post refuses them)
@@ -82,6 +86,7 @@ class PostManifest:
     routines: bool = False
     module_data: bool = False
     runtime_targets: bool = False
+    program_params: bool = False
 
 
 def load_manifest(folder: Path) -> PostManifest:
@@ -99,8 +104,16 @@ def load_manifest(folder: Path) -> PostManifest:
     frames_in = str(raw.get("frames_in", "world"))
     if frames_in not in FRAMES_IN:
         raise PostError(f"{path}: frames_in must be one of {', '.join(FRAMES_IN)}")
-    keys = ("rows", "accelerations", "flow", "module_data", "routines", "runtime_targets")
-    rows, accelerations, flow, module_data, routines, runtime_targets = (
+    keys = (
+        "rows",
+        "accelerations",
+        "flow",
+        "module_data",
+        "routines",
+        "runtime_targets",
+        "program_params",
+    )
+    rows, accelerations, flow, module_data, routines, runtime_targets, program_params = (
         _flag(raw, key, path) for key in keys
     )
     return PostManifest(
@@ -121,6 +134,7 @@ def load_manifest(folder: Path) -> PostManifest:
         module_data=module_data,
         routines=routines,
         runtime_targets=runtime_targets,
+        program_params=program_params,
     )
 
 

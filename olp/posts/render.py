@@ -13,7 +13,9 @@ Template context (every file)
 ``program``
     ``name`` (legal name of this file's program: the whole program, a part, or the main),
     ``source`` (the program's file name without folders, escaped for a comment), ``main`` (the
-    main program's name).
+    main program's name), ``params`` (the program's own parameters,
+    :attr:`olp.ir.Program.params`: a post whose manifest says ``program_params: true`` writes
+    them; empty in a part and in a split program's main).
 ``split``
     True when the program was split (in parts and in the main).
 ``unit``
@@ -266,7 +268,8 @@ class _Renderer:
                 lines = self.post.comment_lines
                 routines = weave_routines(self.compiled.program, view, lines)
             view = weave(self.compiled.program, view)
-        unit = Unit(unit_name or self.name, self.name, self.source, index, count, routine)
+        params = self.compiled.program.params if index == 0 else ()
+        unit = Unit(unit_name or self.name, self.name, self.source, index, count, routine, params)
         return unit_context(
             self.post, self.compiled.station, unit, allocation, view, routines, every
         )
@@ -292,6 +295,9 @@ class Unit:
     index: int
     count: int
     routine: str
+    params: tuple[Any, ...] = ()
+    """The program's own parameters (:attr:`olp.ir.Program.params`; a streamed build has none:
+    a program with parameters is never streamed, as it has flow)."""
 
 
 def unit_context(
@@ -310,7 +316,12 @@ def unit_context(
     vendor = post.context_values([*routine_statements(routines), *view])
     written = [RoutineSteps(r.routine, TrackedSteps(post.group(r.steps), post)) for r in routines]
     return {
-        "program": {"name": unit.name, "source": unit.source, "main": unit.main},
+        "program": {
+            "name": unit.name,
+            "source": unit.source,
+            "main": unit.main,
+            "params": unit.params,
+        },
         "split": unit.count > 0,
         "unit": {
             "name": unit.name,

@@ -455,6 +455,12 @@ class UrPost(Post):
     WRITES_FLOW = True
     COLUMNS = True
     WRITES_ROUTINES = True
+    PROGRAM_PARAMS = (
+        "olp writes a program as one def that the controller runs when it receives the "
+        "script, with no arguments to give; a def with parameters would need a caller the "
+        "script does not hold (and URScript passes arguments by value only, so an :OUT "
+        "parameter has no equivalent)"
+    )
     STREAMS = True
     STREAM_NEUTRAL_FILTERS = frozenset({"ur_pad"})
     TOTAL_KINDS = frozenset({"program_too_long"})

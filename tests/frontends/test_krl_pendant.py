@@ -328,13 +328,20 @@ def test_spline_inline_forms(glue: KrlResult) -> None:
     assert list(glue.program.motions())[1].speed.joint_acceleration == 0.6
 
 
-def test_spline_with_items_olp_does_not_model_are_listed(glue: KrlResult) -> None:
-    line_26 = [i.text for i in glue.ignored if i.span.line == 26]
+def test_spline_with_items_olp_does_not_model_are_kept_before_their_motion(
+    glue: KrlResult,
+) -> None:
+    """Payload, gear jerk and collision-detection tolerances of the pendant's spline forms are
+    written back for the controller, just before the motion (the KRL post writes a PTP with
+    its settings before it, not the WITH)."""
+    line_26 = [(n.kind, getattr(n, "text", "")) for n in glue.program if n.span.line == 26]
     assert line_26 == [
-        "$LOAD = SLOAD(FP1.TOOL_NO)",
-        "$GEAR_JERK[1] = SGEAR_JERK(PPDAT1)",
-        "$COLLMON_TOL_PRO[1] = USE_CM_PRO_VALUES(0)",
+        ("verbatim", "$LOAD = SLOAD(FP1.TOOL_NO)"),
+        ("verbatim", "$GEAR_JERK[1] = SGEAR_JERK(PPDAT1)"),
+        ("verbatim", "$COLLMON_TOL_PRO[1] = USE_CM_PRO_VALUES(0)"),
+        ("joint", ""),
     ]
+    assert not [i for i in glue.ignored if i.span.line == 26]
 
 
 def test_with_values_hold_for_their_motion_only() -> None:
@@ -584,10 +591,10 @@ def test_signals_from_config(config: KrlData) -> None:
     result = parse(
         "GRIPPER_CLOSE = TRUE", "WAIT FOR PART_GRIPPED", "WAIT FOR NOT PART_GRIPPED", config=config
     )
-    assert plain(result) == [
-        ir.SetOutput(index=17, value=True),
-        ir.WaitInput(index=5, value=True),
-        ir.WaitInput(index=5, value=False),
+    assert plain(result) == [  # by number, with the name the program used (issue 15)
+        ir.SetOutput(index=17, value=True, signal="GRIPPER_CLOSE"),
+        ir.WaitInput(index=5, value=True, signal="PART_GRIPPED"),
+        ir.WaitInput(index=5, value=False, signal="PART_GRIPPED"),
     ]
 
 

@@ -107,7 +107,9 @@ What is lowered
   recursion is an error. Checks see each routine's body at every call
   (:meth:`olp.ir.Program.expanded`). Routines no call reaches (interrupt handlers, functions)
   are kept unless they move the robot. Other calls become :class:`~olp.ir.Call` (arguments as
-  source text).
+  source text). The program's own parameters (``DEF MoveSettings(nBase:IN, nTool:IN)``, a
+  module other modules call) are :attr:`olp.ir.Program.params`, typed the same way; their
+  values are the caller's, known only when the program runs.
 * **Control flow** becomes :mod:`olp.ir_flow` blocks (re-exported from :mod:`olp.ir`): ``IF``
   -> :class:`~olp.ir.If`, ``SWITCH`` -> :class:`~olp.ir.Switch`, ``WHILE``/``REPEAT``/``LOOP``
   -> :class:`~olp.ir.While`/:class:`~olp.ir.Repeat`/:class:`~olp.ir.Loop`, ``EXIT`` ->

@@ -42,7 +42,7 @@ class Events(Core):
     stop_interrupt_declared: bool = False
 
     def _expr(self, expr: Expr) -> ir.Expr:
-        converted = to_expr(expr, self._input_index)
+        converted = to_expr(expr, self._input_of)
         assert converted is not None
         return converted
 

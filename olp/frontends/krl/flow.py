@@ -51,7 +51,7 @@ _BINARY = {
 }
 _UNARY = {"NOT": "not", "B_NOT": "bit_not"}
 
-InputOf = Callable[[Var], int | None]
+InputOf = Callable[[Var], ir.DigitalInput | None]
 """The digital input a variable reads (``$IN[3]``, a one-bit SIGNAL), if it is one."""
 
 
@@ -89,9 +89,9 @@ def _convert(expr: Expr, input_of: InputOf) -> ir.Expr:
 
 
 def _variable(var: Var, input_of: InputOf) -> ir.Expr:
-    index = input_of(var)
-    if index is not None:
-        return ir.DigitalInput(index=index, span=var.span)
+    found = input_of(var)
+    if found is not None:
+        return found
     out: ir.Expr = ir.Name(name=var.name, span=var.span)
     for selector in var.selectors:
         if isinstance(selector, Field):

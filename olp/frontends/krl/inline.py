@@ -21,6 +21,7 @@ from olp.frontends.krl.ast import (
     FuncCall,
 )
 from olp.frontends.krl.state import (
+    KRL_ONLY_SYSTEM_VARIABLES,
     SYSTEM_REASONS,
     WRITTEN,
     Core,
@@ -245,6 +246,8 @@ class InlineForms(Core):
         handler = self._with_functions().get((key, value.name.upper()))
         if handler is not None:
             handler(value, assign)
+        elif key in KRL_ONLY_SYSTEM_VARIABLES:  # the pendant's folds: $LOAD = SLOAD(...), ...
+            self._keep_system(assign, key, ": a WITH item of this motion, written before it")
         elif key in SYSTEM_REASONS:
             self._ignore(assign, SYSTEM_REASONS[key])
         else:

@@ -61,8 +61,8 @@ from olp.frontends.krl.flow import (
     to_expr,
 )
 from olp.frontends.krl.module_data import with_module_data
-from olp.frontends.krl.motion import Motions
-from olp.frontends.krl.routines import PendingCall, assemble, moves
+from olp.frontends.krl.motion import _BASE_MOTION, Motions
+from olp.frontends.krl.routines import PendingCall, assemble, moves, typed_params
 from olp.frontends.krl.rows import build_instructions
 from olp.frontends.krl.state import (
     DEFAULT_VEL_CP,
@@ -71,6 +71,7 @@ from olp.frontends.krl.state import (
     Pending,
     PendingRows,
     State,
+    code_of,
     is_here,
 )
 from olp.frontends.krl.values import (
@@ -218,15 +219,19 @@ class _Lowering(Motions, Events):
             self._ignore(stmt, f"not reached: the EXIT at line {self.exiting} leaves the loop")
             return
         if self.jumped is not None and not (isinstance(stmt, Other) and stmt.kind == "label"):
-            self._ignore(stmt, f"not reached: the GOTO at line {self.jumped} jumps away")
+            self._keep_dead(stmt, self.jumped)
             return
         self.check_declared(stmt)
         if self.ambiguous and isinstance(stmt, MotionStmt | FastMotion):
             motion = materialise(stmt) if isinstance(stmt, FastMotion) else stmt
+            used = [why for name, why in self.ambiguous.items() if _uses_setting(motion, name)]
+        else:
+            used = []
+        if used:
             if self._controller_settings_motion(motion):
                 self.ctx.spend(stmt)
                 return
-            reasons = "; ".join(sorted(set(self.ambiguous.values())))
+            reasons = "; ".join(sorted(set(used)))
             raise self._error(
                 f"olp cannot tell which motion settings this motion runs with: {reasons}",
                 stmt.span,
@@ -323,7 +328,7 @@ class _Lowering(Motions, Events):
         (:class:`olp.ir.Declare`, one per name)."""
         self.data.declare(stmt, self.variables.declare, local=True)
         for item in stmt.items:
-            dims = tuple(to_expr(d, self._input_index) for d in item.dims or ())
+            dims = tuple(to_expr(d, self._input_of) for d in item.dims or ())
             value = None if item.value is None else self._expr(item.value)
             self.out.append(
                 ir.Declare(
@@ -393,7 +398,7 @@ class _Lowering(Motions, Events):
             self.returned, self.exiting, self.loop_depth, self.loops, self.routine = saved[:5]
             self.jumped, self.return_ends = saved[5], saved_ends
         self._write_back(routine, stmt, bound, finals)
-        args = tuple(to_expr(arg, self._input_index) for arg in stmt.args)
+        args = tuple(to_expr(arg, self._input_of) for arg in stmt.args)
         call = ir.RoutineCall(name=routine.name, args=args, span=stmt.span)
         body = build_instructions(lowered)
         generic = self._generic_body(routine, stmt) if self._reads_params(routine) else None
@@ -501,26 +506,27 @@ class _Lowering(Motions, Events):
             condition = self._expr(stmt.condition)
             self.out.append(ir.WaitUntil(condition=condition, span=stmt.span))
             return
-        index, value = found
-        self.out.append(ir.WaitInput(index=index, value=value, span=stmt.span))
+        index, value, signal = found
+        self.out.append(ir.WaitInput(index=index, value=value, signal=signal, span=stmt.span))
 
-    def _input_condition(self, expr: Expr) -> tuple[int, bool] | None:
-        """``$IN[n]``, ``NOT $IN[n]``, ``$IN[n] == TRUE``, ``$IN[n] <> FALSE`` -> (n, value);
-        a one-bit SIGNAL of an input stands for its ``$IN[n]``."""
+    def _input_condition(self, expr: Expr) -> tuple[int, bool, str | None] | None:
+        """``$IN[n]``, ``NOT $IN[n]``, ``$IN[n] == TRUE``, ``$IN[n] <> FALSE`` -> (n, value,
+        None); a one-bit SIGNAL of an input stands for its ``$IN[n]``, with its name where
+        the written program can use it (:meth:`_signal_name`)."""
         if isinstance(expr, Var) and expr.key == "$IN[]":
-            return self._single_index(expr, "$IN"), True
+            return self._single_index(expr, "$IN"), True, None
         if isinstance(expr, Var) and not expr.selectors:
             signal = self._value(expr)
             if isinstance(signal, Signal) and signal.io == "$IN":
-                return signal.index, True
+                return signal.index, True, self._signal_name(expr, signal)
         if isinstance(expr, Unary) and expr.op == "NOT":
             inner = self._input_condition(expr.operand)
-            return None if inner is None else (inner[0], not inner[1])
+            return None if inner is None else (inner[0], not inner[1], inner[2])
         if isinstance(expr, Binary) and expr.op in ("==", "<>"):
             for var, other in ((expr.left, expr.right), (expr.right, expr.left)):
                 inner, value = self._input_condition(var), self._value(other)
                 if inner is not None and isinstance(value, Bool):
-                    return inner[0], (inner[1] == value.value) == (expr.op == "==")
+                    return inner[0], (inner[1] == value.value) == (expr.op == "=="), inner[2]
         return None
 
     # ---- loops and other control flow
@@ -749,7 +755,7 @@ class _Lowering(Motions, Events):
             self.track = dataclasses.replace(tracks[0])
 
     def _expr(self, expr: Expr) -> ir.Expr:
-        converted = to_expr(expr, self._input_index)
+        converted = to_expr(expr, self._input_of)
         assert converted is not None
         return converted
 
@@ -764,6 +770,28 @@ class _Lowering(Motions, Events):
             self.routine.pending.setdefault(name, []).append(self._snapshot())
         self.out.append(ir.Goto(label=stmt.name or "", span=stmt.span))
         self.jumped = stmt.span.line
+
+    def _keep_dead(self, stmt: Stmt, goto: int) -> None:
+        """A statement no path reaches, after the GOTO at line ``goto``: kept as its source
+        lines (a block line by line, comments left out), each a :class:`~olp.ir.Verbatim`,
+        not lowered: a motion in it is neither checked nor timed, and in the output it stays
+        where the GOTO jumps over it (a label a GOTO targets ends the dead stretch: see
+        :meth:`lower_statement`)."""
+        source = self.sources.source(stmt.span.file)
+        span = stmt.span
+        reason = f"not reached: the GOTO at line {goto} jumps away"
+        self._note(
+            span,
+            f"the statements after the GOTO at line {goto} are never reached: kept as written, "
+            "not checked or timed",
+            once=f"dead-{span.file}-{goto}",
+        )
+        last = span.end_line if span.end_line is not None else span.line
+        for number in range(span.line, max(last, span.line) + 1):  # a block: to its END...
+            text = code_of((source.line(number) if source is not None else None) or "")
+            if text:
+                where = ir.SourceSpan(span.file, number, 1)
+                self._keep_text(text, where, reason, krl_only=True)
 
     def _label(self, stmt: Other) -> None:
         name = (stmt.name or "").upper()
@@ -838,6 +866,8 @@ class _Lowering(Motions, Events):
             self.exiting = stmt.span.line
         elif stmt.kind == "EXIT" and self.loop_depth > 0:
             self.exiting = stmt.span.line
+        elif stmt.kind == "EXT":
+            self._keep_krl_only(stmt, OTHER_REASONS[stmt.kind])
         elif stmt.kind in _KEPT_OTHERS:
             self._keep(stmt, OTHER_REASONS[stmt.kind])
         else:
@@ -865,6 +895,23 @@ _SETTING_NAMES = {
     "ori_type": "$ORI_TYPE",
     "circ_type": "$CIRC_TYPE",
 }
+
+
+def _uses_setting(motion: MotionStmt, name: str) -> bool:
+    """Whether ``motion`` runs with motion setting ``name`` (a field of :class:`State`).
+
+    ``$APO.CDIS`` is the distance of a ``C_DIS`` approximation (KSS 8 "Approximate
+    positioning": the motion's approximation parameter names which ``$APO`` component
+    applies; without one the motion is an exact stop), and ``$CIRC_TYPE`` applies to circular
+    motions only. A motion without approximation, or not a CIRC, may run where the paths that
+    reach it disagree on that setting (a loop that writes ``$APO.CDIS`` before its C_DIS
+    motion, as the KRL post does): the setting stays ambiguous for the next motion that
+    uses it. Every other setting is taken as used by every motion."""
+    if name == "cdis_mm":
+        return bool(motion.approx)
+    if name == "circ_type":
+        return _BASE_MOTION.get(motion.keyword) == "CIRC"
+    return True
 
 
 # ------------------------------------------------------------------------------------------------
@@ -901,14 +948,21 @@ def lower_module(
     body = build_instructions(lowering.out)
     assembled = assemble(body, alone, {k: v for k, v in table.items() if v is not main}, sources)
     ignored = sorted(
-        [*lowering.ignored, *assembled.ignored, *_program_parameters(main, sources)],
-        key=lambda i: (i.span.line, i.span.column),
+        [*lowering.ignored, *assembled.ignored], key=lambda i: (i.span.line, i.span.column)
     )
     for data_list in (dat, config):
         ignored.extend(data_list.ignored if data_list is not None else ())
     name = main.name if main is not None else _module_name(src, routines)
+    params: tuple[ir.Parameter, ...] = ()
+    instructions = list(assembled.instructions)
+    if main is not None:
+        params, instructions = typed_params(main, instructions)
     program = ir.Program(
-        name=name, instructions=assembled.instructions, source=src, routines=assembled.routines
+        name=name,
+        instructions=tuple(instructions),
+        source=src,
+        routines=assembled.routines,
+        params=params,
     )
     program = with_module_data(program, dat, config, shared)
     return KrlResult(
@@ -920,28 +974,14 @@ def lower_module(
     )
 
 
-def _program_parameters(main: Routine | None, sources: SourceSet) -> list[IgnoredLine]:
-    """The program's own parameters (``DEF MoveTo(nBase:IN, nTool:IN)``, a module other modules
-    call) are not in the IR's program, which takes none: the written ``DEF`` has empty
-    parentheses and their ``DECL`` lines declare local variables, so a caller's arguments would
-    not reach it. Said at the ``DEF`` line, as a statement not in the output."""
-    if main is None or not main.params:
-        return []
-    names = ", ".join(p.name for p in main.params)
-    span = dataclasses.replace(main.span, end_line=main.span.line, end_column=None)
-    reason = (
-        f"the program's parameters ({names}) are not kept: the written DEF takes none and "
-        "declares them as local variables, so a caller's arguments would not reach it"
-    )
-    return [IgnoredLine(span, sources.snippet(span), reason)]
-
-
 def _variables(values: Any, ctx: Context, main: Routine | None) -> Variables:
     variables = Variables(values, ctx.unknown_name)
     params = () if main is None else main.params
     variables.push(
         {
-            p.name.upper(): Unknown(f"{p.name} is a parameter of the program; olp does not know it")
+            p.name.upper(): Unknown(
+                f"{p.name} is a parameter of the program: a caller gives it when it runs"
+            )
             for p in params
         }
     )

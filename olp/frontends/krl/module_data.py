@@ -75,7 +75,7 @@ def _visible(data: KrlData) -> Iterable[str]:
     return data.exported() if data.public else data.declarations
 
 
-def _no_input(var: Var) -> int | None:
+def _no_input(var: Var) -> ir.DigitalInput | None:
     return None
 
 

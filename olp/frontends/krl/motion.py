@@ -250,7 +250,7 @@ class Motions(InlineForms):
         self.track.lose(f"the {stmt.keyword} at line {stmt.span.line} goes to a run-time target")
 
     def _target_expr(self, expr: Expr) -> ir.Expr:
-        converted = to_expr(expr, self._input_index)
+        converted = to_expr(expr, self._input_of)
         assert converted is not None
         return converted
 

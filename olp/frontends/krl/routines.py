@@ -193,34 +193,53 @@ def _difference(node: Any) -> str:
     return f"the {node.kind.replace('_', ' ')} statement"
 
 
+def typed_params(
+    routine: Routine, body: Sequence[Any]
+) -> tuple[tuple[ir.Parameter, ...], list[Any]]:
+    """``routine``'s parameters (:class:`olp.ir.Parameter`), typed by the declarations of
+    their names at the top of ``body`` (KRL declares a parameter's type in the body:
+    ``DEF Move(nBase:IN)`` then ``DECL INT nBase``), and ``body`` without those declarations.
+    A parameter without a mark is KRL's ``:OUT`` (by reference). Used for the module's routines
+    and for the program itself (``DEF MoveSettings(nBase:IN, nTool:IN)``, a module others call).
+    """
+    names = {p.name.upper() for p in routine.params}
+    types: dict[str, ir.Declare] = {}
+    rest: list[Any] = []
+    for node in body:
+        if isinstance(node, ir.Declare) and node.name.upper() in names:
+            types.setdefault(node.name.upper(), node)
+        else:
+            rest.append(node)
+    params = []
+    for p in routine.params:
+        decl = types.get(p.name.upper())
+        params.append(
+            ir.Parameter(
+                name=p.name,
+                type_name="" if decl is None else decl.type_name,
+                dims=() if decl is None else decl.dims,
+                direction="in" if p.direction == "IN" else "out",
+                span=routine.span if decl is None else decl.span,
+            )
+        )
+    return tuple(params), rest
+
+
 def _routine(routine: Routine, body: tuple[Any, ...], sources: SourceSet) -> ir.Routine:
     """The IR routine: declarations of parameters give their types, the other declarations
     at the top of the body are its locals."""
     from olp.frontends.krl.flow import to_expr
 
-    params = {p.name.upper(): p for p in routine.params}
-    types: dict[str, ir.Declare] = {}
+    parameters, nodes = typed_params(routine, body)
     local: list[ir.Declare] = []
     rest: list[Any] = []
-    for node in body:
-        if isinstance(node, ir.Declare) and node.name.upper() in params:
-            types.setdefault(node.name.upper(), node)
-        elif isinstance(node, ir.Declare) and not any(
+    for node in nodes:
+        if isinstance(node, ir.Declare) and not any(
             d.name.upper() == node.name.upper() for d in local
         ):
             local.append(node)
         elif not isinstance(node, ir.Declare):
             rest.append(node)
-    parameters = tuple(
-        ir.Parameter(
-            name=p.name,
-            type_name=types[p.name.upper()].type_name if p.name.upper() in types else "",
-            dims=types[p.name.upper()].dims if p.name.upper() in types else (),
-            direction="in" if p.direction == "IN" else "out",
-            span=types[p.name.upper()].span if p.name.upper() in types else routine.span,
-        )
-        for p in routine.params
-    )
     dims = tuple(to_expr(d, lambda _: None) for d in routine.returns_dims)
     return ir.Routine(
         name=routine.name,

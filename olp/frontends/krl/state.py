@@ -221,16 +221,32 @@ KEPT_SYSTEM_VARIABLES = frozenset(
         "$LOAD",
         "$GEAR_JERK[]",
         "$JERK",
+        "$COLLMON_TOL_PRO[]",
     }
 )
 """Motion parameters olp does not model yet but must not lose: kept as :class:`~olp.ir.Verbatim`
 (timing does not use them; the KRL post writes them back)."""
+KRL_ONLY_SYSTEM_VARIABLES = frozenset({"$LOAD", "$GEAR_JERK[]", "$COLLMON_TOL_PRO[]"})
+"""System variables that only mean something on a KUKA controller (payload data, gear jerk
+limits, collision-detection tolerances): kept for the KRL post (also from a spline WITH, where
+the pendant's motion folds set them), left out by other posts with a warning
+(:meth:`Core._keep_krl_only`)."""
+TIMING_NOTES = {
+    "$OV_PRO": "the program override ($OV_PRO) scales the speed of every motion after it: "
+    "olp does not model it, so its cycle time is the program's at 100 %",
+}
+"""What a kept system variable does to olp's figures, said once per program (keys as
+:attr:`Var.key`)."""
+INPUT_ASSIGNMENT = "is an input ({io}) and cannot be set"
+"""Why an assignment to an input is left out (with a warning): the controller sets inputs.
+Whether the KRL compiler refuses it is not verified, so olp does not stop on it."""
 SYSTEM_REASONS = {
     **SYSTEM_REASONS,
     "$ACC.ORI1": "orientation acceleration ($ACC.ORI1) is not part of olp's IR",
     "$ACC.ORI2": "orientation acceleration ($ACC.ORI2) is not part of olp's IR",
     "$VEL.ORI1": "orientation speed ($VEL.ORI1) is not lowered",
     "$VEL.ORI2": "orientation speed ($VEL.ORI2) is not lowered",
+    "$IN[]": f"$IN {INPUT_ASSIGNMENT.format(io='$IN')}",
 }
 
 
@@ -252,6 +268,20 @@ WRITTEN = "written"
 INLINE_FORM_DATA = frozenset({"PDAT_ACT", "LDAT_ACT", "FDAT_ACT"})
 """What the pendant's inline forms assign for BAS to read: absorbed into the motions' speeds,
 zones, tools and bases (:mod:`olp.frontends.krl.inline`), not kept as assignments."""
+
+
+def code_of(line: str) -> str:
+    """``line`` without its comment (a ``;`` outside a string or character constant) and
+    surrounding blanks."""
+    quote = None
+    for index, char in enumerate(line):
+        if quote is not None:
+            quote = None if char == quote else quote
+        elif char in "\"'":
+            quote = char
+        elif char == ";":
+            return line[:index].strip()
+    return line.strip()
 
 
 def calls_function(expr: Expr) -> bool:
@@ -291,6 +321,7 @@ class Context:
         self.budget = self.remaining = budget
         self.config = config
         self.module_dat = dat
+        self.src = src
         self.shared = tuple(shared)
         self.src_name = os.path.basename(src)
         self.files = [src, *(d.filename for d in (dat, config, *self.shared) if d is not None)]
@@ -479,34 +510,62 @@ class Core:
         from olp.frontends.krl.flow import to_expr
 
         target = to_expr(stmt.target, lambda _: None)
-        value = to_expr(stmt.value, self._input_index)
+        value = to_expr(stmt.value, self._input_of)
         assert target is not None and value is not None
         return ir.Assign(target=target, value=value, span=stmt.span)
 
-    def _input_index(self, var: Var) -> int | None:
-        """The input number of ``$IN[n]`` (a constant ``n``) or of a one-bit SIGNAL of an
-        input: read as :class:`~olp.ir.DigitalInput` wherever an expression is."""
+    def _input_of(self, var: Var) -> ir.DigitalInput | None:
+        """``$IN[n]`` (a constant ``n``) or a one-bit SIGNAL of an input as the
+        :class:`~olp.ir.DigitalInput` it reads, wherever an expression is (with the signal's
+        name where :meth:`_signal_name` keeps it)."""
         if var.key == "$IN[]":
             index = var.selectors[0]
             assert isinstance(index, Index)
             arg = index.args[0] if len(index.args) == 1 else None
-            return None if arg is None else as_int(self._value(arg))
+            number = None if arg is None else as_int(self._value(arg))
+            return None if number is None else ir.DigitalInput(index=number, span=var.span)
         if not var.selectors:
             signal = self._value(var)
             if isinstance(signal, Signal) and signal.io == "$IN":
-                return signal.index
+                name = self._signal_name(var, signal)
+                return ir.DigitalInput(index=signal.index, signal=name, span=var.span)
         return None
+
+    def _signal_name(self, var: Var, signal: Signal) -> str | None:
+        """The name ``var`` reads ``signal`` by, where the written program can use it too: a
+        SIGNAL declared outside the module (``$config.dat``, another module's data list),
+        which the controller declares for the written program as for its source. One in the
+        module's own ``.src`` or ``.dat`` is not written back, so the post writes the number
+        there (None)."""
+        dat = self.ctx.module_dat
+        own = {self.ctx.src, *(() if dat is None else (dat.filename,))}
+        return None if signal.span.file in own else var.name
 
     def _keep(self, stmt: Stmt | Assign, reason: str) -> None:
         """Keep a statement olp does not model as :class:`~olp.ir.Verbatim` (its text without
         the comment): the KRL post writes it back, other posts stop on it."""
-        text = self.sources.snippet(stmt.span).split(";", 1)[0].strip()
+        self._keep_text(code_of(self.sources.snippet(stmt.span)), stmt.span, reason)
+
+    def _keep_krl_only(self, stmt: Stmt | Assign, reason: str) -> None:
+        """Keep a statement that only means something on a KUKA controller (an ``EXT``
+        declaration, payload data, code a GOTO jumps over): the KRL post writes it back; to
+        another post it is harmless to leave out, with a warning giving ``reason``.
+
+        The IR's mark for that is not in this branch: until it is, this keeps a plain
+        :class:`~olp.ir.Verbatim` (other posts stop on it, as on any kept statement)."""
+        self._keep_text(code_of(self.sources.snippet(stmt.span)), stmt.span, reason, True)
+
+    def _keep_text(
+        self, text: str, span: ir.SourceSpan, reason: str, krl_only: bool = False
+    ) -> None:
+        """Keep ``text`` (one statement of the source at ``span``) as written; ``krl_only``:
+        it only means something on a KUKA controller (not marked in the IR yet)."""
         try:
-            kept = ir.Verbatim(text=text, language="krl", reason=reason, span=stmt.span)
+            kept = ir.Verbatim(text=text, language="krl", reason=reason, span=span)
         except ir.FlowError as exc:  # a control character (a lone carriage return) inside it
             raise self._error(
                 f"olp keeps this statement as written, but it is not one clean line: {exc}",
-                stmt.span,
+                span,
                 hint="remove the control character from the statement",
             ) from None
         self.out.append(kept)
@@ -604,10 +663,16 @@ class Core:
         if setter is not None:
             setter(key, stmt.value, stmt)
         elif key in KEPT_SYSTEM_VARIABLES:
-            self._keep(stmt, SYSTEM_REASONS[key])
+            self._keep_system(stmt, key)
+        elif key in SYSTEM_REASONS:  # $BWDSTART, an input ($IN[n] = ...), $CIRC_MODE
+            self._ignore(stmt, SYSTEM_REASONS[key])
         elif key.startswith("$"):
-            generic = f"system variable {key.split('[')[0]} is not lowered yet"
-            self._ignore(stmt, SYSTEM_REASONS.get(key, generic))
+            # a timer, a flag, a message text, torque monitoring: it changes what the program
+            # does on the controller, so it is written back, never left out
+            name = key.split("[")[0]
+            self._keep(stmt, f"system variable {name} is not modelled: kept as written")
+            if key in TIMING_NOTES:
+                self._note(stmt.span, TIMING_NOTES[key], once=key)
         elif self._is_signal(stmt.target):
             self._signal_output(stmt)
         else:
@@ -625,6 +690,15 @@ class Core:
                 self.absorbed_data[name] = WRITTEN
             else:
                 self.absorbed_data[name] = None if stmt.target.selectors else stmt
+
+    def _keep_system(self, stmt: Assign, key: str, why: str = "") -> None:
+        """Keep an assignment of a system variable olp does not model
+        (:data:`KEPT_SYSTEM_VARIABLES`); ``why`` is added to its reason."""
+        reason = SYSTEM_REASONS[key] + why
+        if key in KRL_ONLY_SYSTEM_VARIABLES:
+            self._keep_krl_only(stmt, reason)
+        else:
+            self._keep(stmt, reason)
 
     def _set_vel_cp(self, name: str, value: Expr, stmt: Stmt) -> None:
         self._vel_cp(self._number(value, "$VEL.CP (m/s)"), value.span)
@@ -724,12 +798,14 @@ class Core:
                 return
         self._output(self._single_index(stmt.target, "$OUT"), value, stmt)
 
-    def _output(self, index: int, value: Expr, stmt: Assign) -> None:
+    def _output(self, index: int, value: Expr, stmt: Assign, signal: str | None = None) -> None:
         constant = self._value(value)
         if not isinstance(constant, Bool):
             self._keep(stmt, "an output set to a value olp does not know (not TRUE or FALSE)")
             return
-        self.out.append(ir.SetOutput(index=index, value=constant.value, span=stmt.span))
+        self.out.append(
+            ir.SetOutput(index=index, value=constant.value, signal=signal, span=stmt.span)
+        )
 
     def _is_signal(self, target: Var) -> bool:
         return not target.selectors and isinstance(self._value(target), Signal)
@@ -738,9 +814,9 @@ class Core:
         signal = self._value(stmt.target)
         assert isinstance(signal, Signal)
         if signal.io != "$OUT":
-            self._ignore(stmt, f"{stmt.target.name} is an input ({signal.io}) and cannot be set")
+            self._ignore(stmt, f"{stmt.target.name} {INPUT_ASSIGNMENT.format(io=signal.io)}")
             return
-        self._output(signal.index, stmt.value, stmt)
+        self._output(signal.index, stmt.value, stmt, self._signal_name(stmt.target, signal))
 
     def _set_home(self, name: str, value: Expr, stmt: Stmt) -> None:
         """``$H_POS = XHOME``: olp learns the home position (for ``PTP $H_POS``) and keeps the
