@@ -156,7 +156,21 @@ CASES: dict[str, Case] = {
         1,
         r"prog\.src:\d+:\d+: error",
     ),
-    "krl: unknown point": krl("PTP XNOWHERE", 2, r"prog\.src:3:\d+: .*XNOWHERE"),
+    # every file where the controller would find it given (without them: a run-time motion)
+    "krl: unknown point": Case(
+        {
+            "cell.yaml": CELL,
+            "prog.src": KRL_HEAD + "PTP XNOWHERE\nEND\n",
+            "prog.dat": "DEFDAT prog\nENDDAT\n",
+            "config.dat": "DEFDAT $CONFIG\nENDDAT\n",
+        },
+        [
+            *("build", "{d}/cell.yaml", "{d}/prog.src", "-o", "{d}/out"),
+            *("--config-dat", "{d}/config.dat"),
+        ],
+        2,
+        r"prog\.src:3:\d+: .*XNOWHERE",
+    ),
     "krl: S out of range": krl(
         "PTP {X 500,Y 0,Z 500,A 0,B 90,C 0,S 99,T 0}", 2, r"prog\.src:3:\d+: .*S"
     ),

@@ -518,6 +518,12 @@ UNDECLARED_HINT = (
     "vendor's program cannot refer to"
 )
 """What would declare a name the program uses without a declaration."""
+UNDECLARED_FUNCTION_HINT = (
+    "olp writes only calls of the program's own functions (KRL: a DEFFCT of the module); a "
+    "function of another module or of the KUKA controller is not one another vendor's "
+    "program has"
+)
+"""What would declare a function the program calls without a declaration."""
 EVENT_TYPES = (ir.InterruptDecl, ir.InterruptSwitch, ir.PathTrigger)
 """Statements a post other than KUKA's does not write (an ``unsupported`` error of their own)."""
 
@@ -539,18 +545,50 @@ def undeclared_names(
     variables too where ``routines_see_main``: URScript's first-level variables are global,
     RAPID's entry-routine data is not); FOR counters (RAPID declares its loop variable
     itself, URScript's while assigns it first); and what ``mapped`` says the post maps to a
-    name of its own. Interrupt and trigger statements are not looked into: a post that does
-    not write them refuses them."""
+    name of its own. A function a call in an expression names must be one of ``routines``
+    (or one ``mapped``): the text would otherwise call a function the target language does not
+    have (KRL's ``fnGetPart(1)`` of another module). Interrupt and trigger statements are not
+    looked into: a post that does not write them refuses them."""
     main = [n for n in _own_nodes(nodes) if isinstance(n, ir.Declare)]
     shared = {d.name.casefold() for d in main if d.scope in ("module", "external") or d.exported}
-    out = _undeclared_in(nodes, {d.name.casefold() for d in main}, "the program", mapped)
+    functions = {r.name.casefold() for r in routines}
+    declared = {d.name.casefold() for d in main}
+    out = _undeclared_in(nodes, _Declared(declared, functions, mapped), "the program")
     for routine in routines:
         own = {p.name.casefold() for p in routine.params}
         own |= {d.name.casefold() for d in routine.declarations}
         own |= {n.name.casefold() for n in _own_nodes(routine.body) if isinstance(n, ir.Declare)}
-        seen = own | shared | ({d.name.casefold() for d in main} if routines_see_main else set())
-        out += _undeclared_in(routine.body, seen, f"routine {routine.name}", mapped)
+        seen = own | shared | (declared if routines_see_main else set())
+        known = _Declared(seen, functions, mapped)
+        out += _undeclared_in(routine.body, known, f"routine {routine.name}")
     return out
+
+
+@dataclass(frozen=True, slots=True)
+class _Declared:
+    """The variables (case-folded) and functions a part of the program may name."""
+
+    variables: set[str]
+    functions: set[str]
+    mapped: Callable[[str], bool]
+
+    def problem(self, node: Any, where: str, counters: set[str]) -> str | None:
+        for name in names_of(node):
+            key = name.casefold()
+            if key not in self.variables and key not in counters and not self.mapped(name):
+                return f"{name} is not declared in {where}: {UNDECLARED_HINT}"
+        for name in calls_of(node):
+            if name.casefold() not in self.functions and not self.mapped(name):
+                return f"{name}(...) is not a function of the program: {UNDECLARED_FUNCTION_HINT}"
+        return None
+
+
+def calls_of(node: Any) -> Iterator[str]:
+    """The function every call in ``node``'s own expressions names (not in its bodies)."""
+    for expr in exprs_of(node):
+        for sub in walk(expr):
+            if isinstance(sub, ir.FunctionCall):
+                yield sub.name
 
 
 def _own_nodes(nodes: Iterable[Any]) -> Iterator[Any]:
@@ -562,22 +600,16 @@ def _own_nodes(nodes: Iterable[Any]) -> Iterator[Any]:
                 yield from _own_nodes(body)
 
 
-def _undeclared_in(
-    nodes: Sequence[Any], declared: set[str], where: str, mapped: Callable[[str], bool]
-) -> list[tuple[Any, str]]:
+def _undeclared_in(nodes: Sequence[Any], known: _Declared, where: str) -> list[tuple[Any, str]]:
     own = list(_own_nodes(nodes))
     counters = {n.variable.casefold() for n in own if isinstance(n, ir.For)}
     out: list[tuple[Any, str]] = []
     for node in own:
         if isinstance(node, EVENT_TYPES):
             continue
-        for name in names_of(node):
-            key = name.casefold()
-            if key in declared or key in counters or mapped(name):
-                continue
-            message = f"{name} is not declared in {where}: {UNDECLARED_HINT}"
-            out.append((node, message))
-            break
+        problem = known.problem(node, where, counters)
+        if problem is not None:
+            out.append((node, problem))
     return out
 
 

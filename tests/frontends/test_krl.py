@@ -404,16 +404,13 @@ def test_other_routines_are_listed() -> None:
         ("PTP {A1 1,A2 2}", 5, "A3, A4, A5, A6"),
         ("LIN {X 1,Y 2,Z 3,A 0,B 0,C 0,Q 1}", 30, "'Q'"),
         ("LIN {X 1,X 1,Y 2,Z 3,A 0,B 0,C 0}", 10, "twice"),
-        ("PTP XP1", 5, "'XP1'"),
         ("$VEL.CP = 0", 11, "> 0"),
         ("$VEL.CP = speed", 11, "'speed'"),
         ("$VEL_AXIS[1] = 150", 16, "150"),
-        ("$BASE = my_frame", 9, "my_frame"),
         ("WAIT SEC -1", 10, ">= 0"),
         ("LIN {X 1e999,Y 2,Z 3,A 0,B 0,C 0}", 8, "out of range"),
         ("GOTO somewhere", 1, "GOTO"),
         ("SPL {X 1}", 1, "SPL"),
-        ("BAS(#PTP_PARAMS, 100)", 1, "PTP_PARAMS"),
     ],
 )
 def test_error_location_and_text(line: str, column: int, found: str) -> None:

@@ -126,9 +126,11 @@ def test_the_kuka_post_writes_a_run_time_motion_back_and_the_others_refuse_it(
 
 
 def test_a_name_declared_nowhere_is_still_an_error(config: KrlData) -> None:
-    """A typing error is not a run-time value: ``LIN pUnknown`` names nothing."""
+    """A typing error is not a run-time value: ``LIN pUnknown`` names nothing when every file
+    where the controller would find it was given (the module's .dat and ``$config.dat``)."""
+    text = "\n".join(["DEF t( )", *FRAMES, HOME, "LIN pUnknown", "END", ""])
     with pytest.raises(ParseError, match="pUnknown"):
-        parse(config, *FRAMES, HOME, "LIN pUnknown")
+        parse_krl(text, "t.src", dat=parse_dat("DEFDAT t\nENDDAT\n", "t.dat"), config=config)
 
 
 def test_a_local_position_never_given_a_value_is_still_an_error(config: KrlData) -> None:

@@ -53,8 +53,10 @@ def test_a_program_reads_global_points_of_a_public_data_list(how: str) -> None:
 def test_names_not_global_or_of_a_list_not_public_stay_hidden(tmp_path: Path) -> None:
     src = tmp_path / "uses_scratch.src"
     src.write_text("DEF uses_scratch( )\nPTP XSCRATCH\nEND\n")
+    # every file where the controller would find a name is given: the module's own .dat too
+    (tmp_path / "uses_scratch.dat").write_text("DEFDAT uses_scratch\nENDDAT\n")
     with pytest.raises(ParseError, match="XSCRATCH is not declared"):
-        load_krl(src, data_lists=[POSITIONS])  # declared in Positions.dat, but not GLOBAL
+        load_krl(src, CONFIG, data_lists=[POSITIONS])  # in Positions.dat, but not GLOBAL
     private = tmp_path / "Private.dat"
     private.write_text("DEFDAT Private\nDECL GLOBAL E6AXIS XHIDDEN={A1 0,A2 -90,A3 90}\nENDDAT\n")
     with pytest.raises(ParseError, match="DEFDAT Private is not PUBLIC") as info:
@@ -62,7 +64,9 @@ def test_names_not_global_or_of_a_list_not_public_stay_hidden(tmp_path: Path) ->
     assert info.value.span.file == str(private) and info.value.span.line == 1
     src.write_text("DEF uses_scratch( )\nPTP XHIDDEN\nEND\n")
     with pytest.raises(ParseError, match="XHIDDEN is not declared"):
-        load_krl(src, data_lists_from=tmp_path)  # a folder's lists that are not PUBLIC: skipped
+        load_krl(
+            src, CONFIG, data_lists_from=tmp_path
+        )  # a folder's lists that are not PUBLIC: skipped
 
 
 def test_the_modules_own_names_hide_global_ones(tmp_path: Path) -> None:

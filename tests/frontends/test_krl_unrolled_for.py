@@ -69,3 +69,17 @@ def test_a_counter_set_again_or_counted_again_is_read_as_written(tmp_path: Path)
     assert [n.value.value for n in counts] == [7]  # type: ignore[attr-defined]
     outputs = [n.index for n in leaves(program.instructions) if isinstance(n, ir.SetOutput)]
     assert outputs == [1, 2, 3, 1, 2, 3]  # both loops unrolled
+
+
+def test_a_component_or_text_named_like_the_counter_is_not_a_read(tmp_path: Path) -> None:
+    """``FOR X = 1 TO 6`` (a pallet cell's axis loop), then ``pStack.X = pStack.X + 100`` and a
+    text ``'X'``: the component X and the text are not the counter (before, any string that
+    spelt the counter's name counted as a read)."""
+    head = HEAD.replace("DECL INT i", "DECL INT X\nDECL E6POS pStack\nDECL CHAR sAxis[2]")
+    path = tmp_path / "cell.src"
+    loop = "FOR X = 1 TO 6\n  $VEL_AXIS[X] = 85\nENDFOR\n"
+    after = 'pStack = $POS_ACT\npStack.X = pStack.X + 100\nsAxis[] = "X"\nLIN pStack\n'
+    path.write_text(head + loop + after + "END\n")
+    program = load_krl(path).program
+    assigned = [n for n in leaves(program.instructions) if isinstance(n, ir.Assign)]
+    assert [type(n.target).__name__ for n in assigned][-2:] == ["Member", "Index"]

@@ -52,16 +52,26 @@ What is lowered
   ``PTP fnGetPos()``) become :class:`olp.ir.RuntimeMove`: the target stays the expression, the
   tool, base, speed and approximation are those in effect (the posts write them before it as
   before any motion), and ``reason`` says why olp cannot know the target. The passes warn that
-  they cannot check or time it, and the next motion starts where olp does not know. So does
-  ``PTP XHOME`` (or ``XHOME1`` .. ``XHOME6``) when no ``$config.dat`` was given: every KR C4's
-  ``$config.dat`` declares it, its value is the cell's, and olp never guesses it (the reason
-  names the missing file). A ``_REL`` motion by run-time offsets is kept as written
+  they cannot check or time it, and the next motion starts where olp does not know. A
+  ``_REL`` motion by run-time offsets is kept as written
   (:class:`olp.ir.Verbatim`), and only right after a modelled motion of its kind with the same
-  settings, in the same straight stretch (elsewhere an error saying why). A name declared
-  nowhere else stays an error naming the data list that would declare it. A motion whose
+  settings, in the same straight stretch (elsewhere an error saying why). A motion whose
   target refers to its start position (``LIN_REL {Z 50}``, ``PTP_REL {A6 15}``, ``LIN {Z
   500}``) right where a run-time motion left the robot is a run-time motion too, its target
   the expression and ``relative`` saying how it refers to the start (only KRL writes it).
+* **Names no file olp read declares.** Where a file the controller would find a name in was
+  not given (the module's ``.dat`` is not beside the ``.src``, or no ``$config.dat``), such a
+  name is a value known only when the program runs, never guessed: a warning per name at its
+  first use says which files are missing and that olp cannot check what depends on it (a
+  misspelling looks the same); motions to it are run-time motions (``PTP XHOME`` without
+  ``$config.dat``: the reason names the file), a BAS reading an inline-form record of it
+  (``FDAT_ACT = FHOME``) is kept as written, and ``$BASE``/``$TOOL`` set from it are kept as
+  written and leave the base (tool) unknown: a motion before it is set again is an error.
+  With every such file given, a name declared nowhere is an error where olp needs its value
+  (naming the data list that would declare it) and a warning elsewhere: the controller's
+  compiler refuses it. A function that no ``DEFFCT`` of the module, ``EXTFCT`` or KRL system
+  function declares is written as it stands, with a warning
+  (:mod:`olp.frontends.krl.declared`).
 * **BAS with run-time values** (``BAS(#PTP_PARAMS, v)``, or ``PDAT_ACT`` given a parameter) is
   kept as written; the settings it sets are ambiguous until set again, and a motion that runs
   with one of them (a PTP: tool, base, axis speeds and accelerations; a LIN/CIRC: tool, base,

@@ -175,23 +175,28 @@ def joined(values: Sequence[Value], reason: str) -> Value:
 
 def reads_name(nodes: Sequence[Any], name: str) -> bool:
     """Whether lowered ``nodes`` read the variable ``name``: a :class:`ir.Name` in any of their
-    expressions, or the word in a statement kept as text (a verbatim line, a call's arguments)."""
+    expressions, or the word in a statement kept as text (a verbatim line, a call's arguments).
+    Other text is not code: a component (``p.X``), a constant (``'X'``), olp's reasons."""
     word = re.compile(rf"(?<![\w$]){re.escape(name)}(?![\w$])", re.IGNORECASE)
-    pending: list[Any] = list(nodes)
+    pending: list[tuple[Any, bool]] = [(node, False) for node in nodes]
     while pending:
-        node = pending.pop()
+        node, code = pending.pop()
         if isinstance(node, ir.Comment):  # a remark, not a statement: it reads nothing
             continue
         if isinstance(node, ir.Name):
             if node.name.upper() == name.upper():
                 return True
         elif isinstance(node, str):
-            if word.search(node):
+            if code and word.search(node):
                 return True
         elif isinstance(node, tuple | list):
-            pending.extend(node)
+            pending.extend((part, code) for part in node)
+        elif isinstance(node, ir.Verbatim):
+            pending.append((node.text, True))
+        elif isinstance(node, ir.Call):
+            pending.append((node.args, True))
         elif dataclasses.is_dataclass(node) and not isinstance(node, ir.SourceSpan):
-            pending.extend(getattr(node, f.name) for f in dataclasses.fields(node))
+            pending.extend((getattr(node, f.name), False) for f in dataclasses.fields(node))
     return False
 
 

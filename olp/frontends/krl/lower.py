@@ -229,6 +229,7 @@ class _Lowering(Motions, Events):
         if self.jumped is not None and not (isinstance(stmt, Other) and stmt.kind == "label"):
             self._keep_dead(stmt, self.jumped)
             return
+        self.check_declared(stmt)
         if self.ambiguous and isinstance(stmt, MotionStmt | FastMotion):
             motion = materialise(stmt) if isinstance(stmt, FastMotion) else stmt
             unsettled = self._unsettled(motion)

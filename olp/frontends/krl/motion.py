@@ -219,10 +219,12 @@ class Motions(InlineForms):
         A run-time target (or a component of an inline aggregate) is one olp cannot evaluate
         although every name it depends on is declared: a position computed from a function's
         result, an input, a parameter, a path-dependent value, a controller variable
-        (``joint = $AXIS_ACT_MEAS``). So is a name of :data:`CONFIG_DAT_POINTS` (``XHOME``)
-        when no ``$config.dat`` was given: every KR C4's ``$config.dat`` declares it, but its
-        value is the cell's, which olp never guesses. Any other name declared nowhere is left
-        to the usual error, which tells the user which data list is missing."""
+        (``joint = $AXIS_ACT_MEAS``). So is one that depends on a name no file olp read
+        declares while a file where the controller would find it was not given (the module's
+        .dat, the controller's $config.dat: ``XHOME`` without it): its value is the cell's,
+        which olp never guesses (:meth:`olp.frontends.krl.state.Context.unknown_name`). A name
+        declared nowhere while every such file was given is left to the usual error, which
+        tells the user which data list is missing."""
         for expr in stmt.targets:
             parts = [m.value for m in expr.members] if isinstance(expr, Aggregate) else [expr]
             for part in parts:
@@ -230,24 +232,7 @@ class Motions(InlineForms):
                 if self._runtime(value):
                     assert isinstance(value, Unknown)
                     return value.reason
-                missing = self._config_point_missing(part, value)
-                if missing is not None:
-                    return missing
         return None
-
-    def _config_point_missing(self, part: Expr, value: Any) -> str | None:
-        """The reason for a motion to a :data:`CONFIG_DAT_POINTS` name without ``$config.dat``
-        (see :meth:`_runtime_target`), else None."""
-        if not (isinstance(value, Unknown) and value.missing) or self.ctx.config is not None:
-            return None
-        if not isinstance(part, Var) or part.selectors:
-            return None
-        if part.name.upper() not in CONFIG_DAT_POINTS:
-            return None
-        return (
-            f"{part.name} is declared in the controller's $config.dat, which was not given "
-            "with --config-dat; olp does not guess its value"
-        )
 
     def _runtime_motion(self, stmt: MotionStmt, base: str, reason: str) -> None:
         """A motion to a run-time target as :class:`~olp.ir.RuntimeMove`: the target stays an
@@ -832,8 +817,12 @@ class Motions(InlineForms):
         unverified); the next motion without WITH gets a note saying so. ``runtime``: why the
         target is known only at run time (then a :class:`~olp.ir.RuntimeMove`), or None."""
         saved = self.state
-        for assignment in stmt.with_clause:
-            self._with_assignment(assignment)
+        self.in_with = True  # a $BASE or $TOOL set from a run-time value cannot be kept here
+        try:
+            for assignment in stmt.with_clause:
+                self._with_assignment(assignment)
+        finally:
+            self.in_with = False
         during = self.state
         if runtime is None:
             self._plain_motion(stmt, base, relative)
@@ -881,12 +870,6 @@ class RuntimeStart(str):
 
     __slots__ = ()
 
-
-CONFIG_DAT_POINTS = frozenset({"XHOME", *(f"XHOME{n}" for n in range(1, 7))})
-"""Points every KR C4 ``$config.dat`` declares (``E6AXIS XHOME``, ``XHOME1`` .. ``XHOME6``:
-found in all seven controller backups of benchmarks/krl_corpus.py that hold one; ``XHOME6``
-in one of them): without a ``$config.dat``, a motion to one is a motion to a run-time target
-whose value olp does not know, never a guess."""
 
 _MOTION_TEXT = re.compile(r"\s*(S?PTP|S?LIN|S?CIRC)(_REL)?\b", re.IGNORECASE)
 

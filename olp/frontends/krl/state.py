@@ -15,6 +15,7 @@ tens of thousands of them.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import os
 from collections.abc import Callable, Sequence
@@ -43,6 +44,7 @@ from olp.frontends.krl.ast import (
     Var,
 )
 from olp.frontends.krl.data import DataOps, KrlData, text_value
+from olp.frontends.krl.declared import KRL_FUNCTIONS, MODELLED_NAMES, external_functions, uses
 from olp.frontends.krl.values import (
     AXES,
     CARTESIAN,
@@ -252,6 +254,14 @@ CONFIG_DAT_DATA = frozenset({"FHOME", "PDEFAULT", "LDEFAULT"})
 """Inline-form data every KR C4 ``$config.dat`` declares (``DECL FDAT FHOME``: all seven
 controller backups of benchmarks/krl_corpus.py that hold one; ``PDEFAULT``/``LDEFAULT``: the
 defaults the pendant's inline forms name)."""
+CONFIG_DAT_POINTS = frozenset({"XHOME", *(f"XHOME{n}" for n in range(1, 7))})
+"""Points every KR C4 ``$config.dat`` declares (``E6AXIS XHOME``, ``XHOME1`` .. ``XHOME6``:
+found in all seven controller backups of benchmarks/krl_corpus.py that hold one; ``XHOME6``
+in one of them)."""
+CONFIG_DAT_NAMES = CONFIG_DAT_DATA | CONFIG_DAT_POINTS
+"""Without a ``$config.dat`` these are values olp does not know, never guesses, and names
+the file of (:meth:`Context.unknown_name`): a motion to ``XHOME`` is a motion to a run-time
+target, a BAS reading ``FDAT_ACT = FHOME`` is kept as written."""
 WRITTEN = "written"
 """An inline-form record whose value the output has set (``absorbed_data``)."""
 
@@ -313,6 +323,8 @@ class Context:
         self.module_dat = dat
         self.src = src
         self.shared = tuple(shared)
+        self.src_name = os.path.basename(src)
+        self.files = [src, *(d.filename for d in (dat, config, *self.shared) if d is not None)]
         self._where = self._describe_files(src)
         # > 0 while a FOR body is tried with its counter unknown: a motion to a run-time
         # target then fails the try, so that the loop is unrolled and its targets known
@@ -326,8 +338,22 @@ class Context:
         shared = "".join(f"; {data_file_name(d)}" for d in self.shared)
         return f"{os.path.basename(src)} ({dat}; {config}{shared})"
 
+    def missing_files(self) -> list[tuple[str, str]]:
+        """The files where the controller finds a name olp did not (the module's ``.dat``, the
+        controller's ``$config.dat``) that olp was not given: (what, how to give it)."""
+        missing = []
+        if self.module_dat is None:
+            dat = f"{os.path.splitext(self.src_name)[0]}.dat"
+            missing.append((f"the module's {dat}", f"put {dat} beside the module"))
+        if self.config is None:
+            missing.append(("the controller's $config.dat", "pass --config-dat"))
+        return missing
+
     def unknown_name(self, name: str) -> Unknown:
-        """Why ``name`` has no value: a controller variable, or declared nowhere olp looked."""
+        """Why ``name`` has no value: a controller variable; a name no file olp read declares
+        while a file where the controller would find it was not given (:meth:`missing_files`):
+        a value known only when the program runs, which olp does not guess; else declared
+        nowhere olp looked (``missing``: the controller's compiler refuses it too)."""
         if name == "$H_POS":
             return Unknown(
                 "$H_POS is not set by the program (the controller keeps it in $machine.dat, "
@@ -337,24 +363,62 @@ class Context:
             )
         if name.startswith("$"):
             return Unknown(f"{name} is a controller variable olp does not track")
-        hints = []
-        if self.module_dat is None:
-            hints.append(
-                "points taught on the pendant are declared in the module's .dat, which must "
-                "sit beside the .src with the same name"
+        if self.config is None and name in CONFIG_DAT_NAMES:
+            return Unknown(
+                f"{name} is declared in the controller's $config.dat, which was not given with "
+                "--config-dat; olp does not guess its value"
             )
-        if self.config is None:
-            hints.append(
-                "XHOME, FHOME, PDEFAULT, TOOL_DATA and BASE_DATA are declared in the "
-                "controller's $config.dat: pass it (--config-dat, or KrlOptions(config_dat=...))"
+        missing = self.missing_files()
+        if missing:
+            return Unknown(
+                f"{name} is not declared in {self._where}: olp takes it as a value known only "
+                "when the program runs",
+                f"{' / '.join(how for _, how in missing)} to check what depends on it",
             )
+        hint = None
         if not self.shared:
-            hints.append(
+            hint = (
                 "a point declared GLOBAL in another module's PUBLIC data list is found with "
                 "--data-list FILE.dat or --data-lists-from FOLDER (KrlOptions(data_lists=...))"
             )
-        where = f"{name} is not declared in {self._where}"
-        return Unknown(where, "; ".join(hints) or None, missing=True)
+        return Unknown(f"{name} is not declared in {self._where}", hint, missing=True)
+
+    def undeclared_message(self, name: str, function: bool) -> str:
+        """The warning for the first use of ``name`` (a variable, or a ``function``) that no
+        file olp read declares."""
+        if function:
+            return (
+                f"{name}(...) is a function no module olp read declares (no DEFFCT in "
+                f"{self.src_name}, no EXTFCT, not a KRL system function): the controller may "
+                "hold it in another module; olp writes the call as it stands and cannot check it"
+            )
+        missing = self.missing_files()
+        if not missing:
+            return (
+                f"{name} is not declared in {self._where}: the controller's compiler refuses a "
+                "name nothing declares, unless another module's PUBLIC data list declares it "
+                "GLOBAL (give it with --data-list FILE.dat or --data-lists-from FOLDER)"
+            )
+        files = " or ".join(what for what, _ in missing)
+        remedy = " / ".join(how for _, how in missing)
+        # the KRL post writes the module's .dat: it replaces the controller's, which olp lacks
+        written = (
+            ""
+            if self.module_dat is not None
+            else ("; the .dat olp writes with a KRL output does not declare it either")
+        )
+        return (
+            f"{name} is not declared in {self._where}: olp takes it as a value known only when "
+            f"the program runs (the controller may find it in {files}) and cannot check what "
+            f"depends on it; a misspelt name looks the same: {remedy} to check these{written}"
+        )
+
+    @functools.cached_property
+    def functions(self) -> frozenset[str]:
+        """The functions (upper case) a call may name without a warning: the module's
+        routines, those an ``EXTFCT`` declares, KRL's system functions."""
+        sources = [s for s in map(self.sources.source, self.files) if s is not None]
+        return frozenset(self.routines) | external_functions(sources) | KRL_FUNCTIONS
 
     def spend(self, stmt: Stmt) -> None:
         self.remaining -= 1
@@ -405,6 +469,7 @@ class Core:
         self.returned: tuple[str, int] | None = None  # (routine, line of its RETURN)
         self.exiting: int | None = None  # line of an EXIT leaving the current loop
         self._after_with: int | None = None  # line of the last motion whose WITH set anything
+        self.in_with = False  # lowering the assignments of a motion's WITH
         self._reported: set[tuple[Any, ...]] = set()
         self.motion_count = 0  # motions lowered so far (by this lowering)
         self.here_vars: dict[str, tuple[str, int]] = {}  # name -> ($POS_ACT..., motion_count)
@@ -512,8 +577,33 @@ class Core:
             self._reported.add(key)
             self.notes.append(Note(span, message))
 
+    def _config_name(self, name: str) -> bool:
+        return self.ctx.config is None and name in CONFIG_DAT_NAMES
+
     def _error(self, message: str, span: ir.SourceSpan, hint: str | None = None) -> ParseError:
         return self.sources.error(message, span, hint)
+
+    def check_declared(self, stmt: Stmt) -> None:
+        """A warning at the first use of each name ``stmt`` uses that no file olp read declares
+        (:meth:`Context.undeclared_message`): a misspelling must not pass unseen, and what
+        olp takes for a run-time value it says it cannot check. Names olp models without their
+        declaration (:data:`~olp.frontends.krl.declared.MODELLED_NAMES`) and the controller's
+        ``$`` variables are not reported, nor, without a ``$config.dat``, the names every one
+        declares (:data:`CONFIG_DAT_NAMES`: not misspelt; what depends on them says so)."""
+        for use in uses(stmt):
+            name = use.name.upper()
+            key = ("undeclared", name, isinstance(use, FuncCall))
+            if key in self._reported:
+                continue
+            if isinstance(use, FuncCall):
+                known = name in self.ctx.functions
+            else:
+                known = name.startswith("$") or name in MODELLED_NAMES
+                known = known or self.variables.is_declared(name) or self._config_name(name)
+            if not known:
+                self._reported.add(key)
+                message = self.ctx.undeclared_message(use.name, isinstance(use, FuncCall))
+                self.notes.append(Note(use.span, message))
 
     # ---- values
     def _value(self, expr: Expr) -> Value:
@@ -594,7 +684,6 @@ class Core:
             else:
                 self.here_vars.pop(name, None)
             self.data.assign(stmt)  # what olp knows of the value afterwards
-            self._config_data_at_run_time(name, stmt)
             if name not in INLINE_FORM_DATA or self._runtime(self.variables.lookup(name)):
                 # PDAT_ACT = pdatNew with a run-time value: the BAS reading it is kept as
                 # written, so the assignment must reach the output too
@@ -611,25 +700,6 @@ class Core:
             self._keep_krl_only(stmt, reason)
         else:
             self._keep(stmt, reason)
-
-    def _config_data_at_run_time(self, name: str, stmt: Assign) -> None:
-        """``FDAT_ACT = FHOME`` (``PDEFAULT``, ``LDEFAULT``: :data:`CONFIG_DAT_DATA`) without a
-        ``$config.dat``: the inline form's data is the cell's, which olp never guesses; it is
-        a value known only when the program runs, so the BAS that reads it is kept as written
-        and the motion right after it runs with the controller's settings
-        (:meth:`olp.frontends.krl.motion.Motions._controller_settings_motion`)."""
-        value = stmt.value
-        if name not in INLINE_FORM_DATA or self.ctx.config is not None:
-            return
-        if not isinstance(value, Var) or value.selectors:
-            return
-        known = self.variables.lookup(name)
-        if value.name.upper() in CONFIG_DAT_DATA and isinstance(known, Unknown) and known.missing:
-            reason = (
-                f"{name} = {value.name}: {value.name} is declared in the controller's "
-                "$config.dat, which was not given with --config-dat; olp does not guess its value"
-            )
-            self.variables.assign(name, Unknown(reason))
 
     def _set_vel_cp(self, name: str, value: Expr, stmt: Stmt) -> None:
         self._vel_cp(self._number(value, "$VEL.CP (m/s)"), value.span)
@@ -795,10 +865,38 @@ class Core:
 
     # ---- tools and bases
     def _set_base(self, name: str, value: Expr, stmt: Stmt) -> None:
-        self._change_frame(self._frame_value(value, "$BASE", stmt.span, ir.Frame, ir.WORLD), stmt)
+        if not self._frame_at_run_time("$BASE", "frame", value, stmt):
+            frame = self._frame_value(value, "$BASE", stmt.span, ir.Frame, ir.WORLD)
+            self._change_frame(frame, stmt)
 
     def _set_tool(self, name: str, value: Expr, stmt: Stmt) -> None:
-        self._change_tool(self._frame_value(value, "$TOOL", stmt.span, ir.Tool, ir.FLANGE), stmt)
+        if not self._frame_at_run_time("$TOOL", "tool", value, stmt):
+            tool = self._frame_value(value, "$TOOL", stmt.span, ir.Tool, ir.FLANGE)
+            self._change_tool(tool, stmt)
+
+    def _frame_at_run_time(self, name: str, setting: str, value: Expr, stmt: Stmt) -> bool:
+        """``$BASE = PalletBase[nActive].Base`` with a value known only when the program runs
+        (a name no file olp read declares, a parameter, ...): kept as written (the KRL post
+        writes it back; the first motion after a kept line gets all its settings written
+        again), and the base (tool) is unknown until the program sets it again: a motion
+        before that is an error (``ambiguous``, as after a BAS with run-time values), since
+        olp can check nothing of where it goes. In a WITH the error stands (returns False)."""
+        ambiguous: dict[str, str] | None = getattr(self, "ambiguous", None)
+        if self.in_with or ambiguous is None:
+            return False
+        if isinstance(value, Var) and value.key in (f"{_DATA_TABLES[name]}[]", "$NULLFRAME"):
+            return False  # read by _frame_value
+        known = self._value(value)
+        if not self._runtime(known):
+            return False
+        assert isinstance(known, Unknown) and isinstance(stmt, Assign)
+        self._keep(stmt, f"{name} is set from a value known only at run time ({known.reason})")
+        ambiguous[setting] = (
+            f"{name} is set at line {stmt.span.line} from a value olp does not know "
+            f"({known.reason})"
+        )
+        self.track.lose_cartesian(f"{name} was set at run time at line {stmt.span.line}")
+        return True
 
     def _change_frame(self, frame: ir.Frame, stmt: Stmt | Assign) -> None:
         if frame != self.state.frame:

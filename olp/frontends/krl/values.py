@@ -71,10 +71,13 @@ class Signal:
 class Unknown:
     """A value olp does not know, and why (shown to the user when a statement needs it).
 
-    ``missing``: a value missing from olp's input or from the program itself, not one the
-    controller computes as it runs: a name it depends on is declared nowhere olp looked (a data
-    list or ``$config.dat`` not given), or a local variable is read before the program gives it
-    a value (the controller stops there too)."""
+    ``missing``: a value missing from the program itself, not one the controller computes as
+    it runs: a name it depends on is declared nowhere although every file where the controller
+    would find it was given (another module's data list may still be missing), or a local
+    variable is read before the program gives it a value (the controller stops there too). A
+    name no file olp read declares while the module's .dat or the ``$config.dat`` was not given
+    is not ``missing``: its value is the controller's, known when the program runs
+    (:meth:`olp.frontends.krl.state.Context.unknown_name`)."""
 
     reason: str
     hint: str | None = None
