@@ -132,18 +132,21 @@ def account(text: str, src: str, result: object, tally: Tally) -> None:
     """Where every statement of the program went: kept (an IR node has its line), absorbed
     into the motions (inline-form data, BAS, $VEL/$TOOL/... settings), an inlined call, a
     warning, or unaccounted (lost without a word: the figure that must be 0)."""
-    from olp.ir import is_motion
+    from olp.ir import RuntimeMove, is_motion
     from olp.ir_flow import leaves_and_blocks
+
+    def moves(node: object) -> bool:  # a run-time motion runs with the settings too
+        return is_motion(node) or isinstance(node, RuntimeMove)  # type: ignore[arg-type]
 
     program = result.compiled.program  # type: ignore[attr-defined]
     lines = statement_lines(text)
     kept = {n.span.line for n in leaves_and_blocks(program.instructions) if n.span.file == src}
     nodes = list(leaves_and_blocks(program.instructions))
-    motions = [n.span.line for n in nodes if is_motion(n) and n.span.file == src]
+    motions = [n.span.line for n in nodes if moves(n) and n.span.file == src]
     for routine in program.routines:  # the module's routines the program keeps, written out too
         nodes = [*routine.params, *routine.declarations, *leaves_and_blocks(routine.body)]
         kept.update(n.span.line for n in nodes if n.span.file == src)
-        motions.extend(n.span.line for n in nodes if is_motion(n) and n.span.file == src)
+        motions.extend(n.span.line for n in nodes if moves(n) and n.span.file == src)
     # a setting is in the output only through a motion that runs with it (the posts write
     # $BASE, $VEL, ... before the motions): one after the module's last motion is lost
     last_motion = max(motions, default=0)
