@@ -107,6 +107,13 @@ MAX_NAME_LENGTH = 24
 """KRL identifiers and module names: 24 characters (widely cited; unverified against KUKA docs)."""
 
 NAME_RULE = NameRule(max_length=MAX_NAME_LENGTH, reserved=KEYWORDS)
+
+_AGGREGATE_PART = r"[A-Za-z0-9_$#.+\-,: \[\]]|" + double_quoted()
+AGGREGATE = rf"\{{(?:{_AGGREGATE_PART}|\{{(?:{_AGGREGATE_PART})*\}})*\}}"
+"""A KRL aggregate as a call argument: ``{rX 810, rY 67}``, ``{POS: X 1, Y 2}``, members that
+are aggregates one level deep, strings without ``"``. No ``;`` outside a string (KRL's comment
+would hide the call's closing parenthesis) and no parenthesis (an aggregate holds constants, no
+call). The alternatives start with different characters, so matching is linear in the length."""
 """A legal KRL name: letters, digits and ``_``, a letter first, 24 characters, not a keyword (a
 keyword gets a trailing ``_``). The .src/.dat file names use it too: DEF name == file name."""
 
@@ -482,9 +489,12 @@ class KukaPost(Post):
             # a whole array or an element (P00(#CHK_HOME, #PGNO_GET, DMY[], 0) in every cell.src;
             # PULSE($OUT[PGNO_REQ], TRUE, 0.2)): names, numbers and commas only inside
             r"\$?" + IDENTIFIER + r"\[[A-Za-z0-9_$,.+\- ]*\]",
+            # an aggregate for a STRUC parameter (DrillHole({rX 810, rY 67, rZ 0})), one
+            # nested level: KRL takes it as it stands. No ';' (a comment) outside its strings
+            AGGREGATE,
         ),
         'numbers, "strings", names, #ENUM values, $ variables, array names and elements '
-        "(NAME[], NAME[1,k])",
+        "(NAME[], NAME[1,k]), aggregates ({X 1, Y 2})",
     )
     ACCELERATIONS: ClassVar[frozenset[str]] = frozenset(
         {"linear_acceleration", "angular_acceleration"}

@@ -313,12 +313,14 @@ class DeclItem:
 
 @dataclass(frozen=True, slots=True)
 class Decl:
-    """``DECL [GLOBAL] [CONST] TYPE name[dims] [= value], ...`` (``is_global``: GLOBAL given)"""
+    """``DECL [GLOBAL] [CONST] TYPE name[dims] [= value], ...`` (``is_global``: GLOBAL given,
+    ``is_const``: CONST given)"""
 
     type_name: str
     items: tuple[DeclItem, ...]
     span: ir.SourceSpan
     is_global: bool = False
+    is_const: bool = False
 
 
 @dataclass(frozen=True, slots=True)

@@ -334,10 +334,16 @@ class _Lowering(Motions, Events):
         move to where the robot already is: nothing to check, kept as written. So does a motion
         to a variable that was given ``$POS_ACT`` with no motion since (``pAct = $POS_ACT`` /
         ``SPTP pAct WITH $VEL_AXIS[1] = 10, ...``): a WITH clause only sets that motion's own
-        speeds and accelerations."""
+        speeds and accelerations.
+
+        Not when settings olp absorbed wait for a motion (the pendant's fold ``PTP $POS_ACT``:
+        ``PDAT_ACT = ...``, ``FDAT_ACT = ...``, ``BAS(#PTP_PARAMS, ...)``): the posts write
+        settings only before the motions olp models, so a kept line would run without them.
+        Then it is a motion to a run-time target (:class:`~olp.ir.RuntimeMove`), which the posts
+        write after the settings in effect."""
         target = stmt.targets[-1] if stmt.targets else None
         simple = stmt.keyword in ("PTP", "SPTP", "LIN", "SLIN") and not stmt.with_clause
-        if simple and isinstance(target, Var) and is_here(target):
+        if simple and isinstance(target, Var) and is_here(target) and not self.unwritten:
             self._keep(stmt, f"moves to where the robot already is ({target.name}): no motion")
             return
         held = self._holds_here(target)

@@ -94,7 +94,10 @@ def _module(dat: KrlData, name: str) -> ir.Declare:
         type_name=decl.type_name,
         dims=dims,
         value=to_expr(item.value, _no_input),
-        exported=decl.is_global,
+        constant=decl.is_const,
+        # GLOBAL exports a name only from a PUBLIC list (data.visible_globals): the post writes
+        # DEFDAT ... PUBLIC, so a GLOBAL of a list without it would become visible elsewhere
+        exported=decl.is_global and dat.public,
         scope="module",
         elements=tuple(elements) if dims else (),
         span=item.span,

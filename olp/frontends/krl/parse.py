@@ -117,6 +117,11 @@ def _is_global(children: tuple[Any, ...]) -> bool:
     return any(isinstance(c, Token) and c.type == "GLOBAL" for c in children)
 
 
+def _is_const(children: tuple[Any, ...]) -> bool:
+    """Whether a declaration's modifiers hold CONST (before or after DECL)."""
+    return any(isinstance(c, Token) and c.type == "CONST" for c in children)
+
+
 class _Case:
     __slots__ = ("body", "values")
 
@@ -317,7 +322,8 @@ class _ToAst(Transformer[Token, Module]):
     def decl(self, meta: Meta, *children: Any) -> Decl:
         type_name = next(c for c in children if isinstance(c, str) and not isinstance(c, Token))
         items = tuple(c for c in children if isinstance(c, DeclItem))
-        return Decl(type_name.upper(), items, self._span(meta), _is_global(children))
+        span, glob, const = self._span(meta), _is_global(children), _is_const(children)
+        return Decl(type_name.upper(), items, span, glob, const)
 
     @_inline
     def bare_decl(self, meta: Meta, *children: Any) -> Decl:
@@ -336,7 +342,8 @@ class _ToAst(Transformer[Token, Module]):
                 first.span,
                 self._source_line(first.span.line),
             )
-        return Decl(str(type_name).upper(), items, self._span(meta), _is_global(children))
+        span, glob, const = self._span(meta), _is_global(children), _is_const(children)
+        return Decl(str(type_name).upper(), items, span, glob, const)
 
     @_inline
     def type_name(self, meta: Meta, name: Any) -> str:
