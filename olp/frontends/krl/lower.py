@@ -164,6 +164,8 @@ class _Lowering(Motions, Events):
         self.past: set[str] = set()  # counters of unrolled FOR loops (see flow.PastFor)
         # statements that set motion settings (absorbed into the motions) since the last motion
         self.unwritten: list[Stmt] = []
+        # a call of a routine olp did not read since the last motion: (its name, its line)
+        self.unread_call: tuple[str, int] | None = None
         self.unwritten_at: list[tuple[list[Any], int]] = []  # each one's output list, position
         self.folds: list[str] = []  # the titles of the source's folds open here, innermost last
         self._blocks: dict[str, Callable[[Block], None]] = {
@@ -399,6 +401,7 @@ class _Lowering(Motions, Events):
             self._keep(stmt, _IGNORED_CALLS[name])
         else:
             self.motion_count += 1  # another module's routine may move the robot
+            self.unread_call = (stmt.name, stmt.span.line)
             args = tuple("" if arg is None else self.sources.snippet(arg.span) for arg in stmt.args)
             self.out.append(ir.Call(name=stmt.name, args=args, span=stmt.span))
 

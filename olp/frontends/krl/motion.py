@@ -77,6 +77,8 @@ kind runs with, besides ``cdis_mm`` when it is approximated (see :meth:`Motions.
 class Motions(InlineForms):
     """Motion statements -> IR motions, tracking where the robot goes."""
 
+    unread_call: tuple[str, int] | None  # set by the statement walk (lower._Lowering._call)
+
     # ---- the fast path
     def _lin_rows(self, rows: LinRows) -> None:
         """Rows of the CAM shape as one :class:`PendingRows` where each would take
@@ -86,6 +88,7 @@ class Motions(InlineForms):
                 self.lower_statement(motion)  # type: ignore[attr-defined]
             return
         self.ctx.remaining -= len(rows)  # what lower_statement spends per line
+        self._note_unread_call(rows.span)
         self._after_kept_settings(rows.span)
         state = self.state
         zone = 0.0 if state.cdis_mm is None else state.cdis_mm / 1000.0
@@ -122,6 +125,8 @@ class Motions(InlineForms):
     def _fast_motion(self, stmt: FastMotion) -> None:
         """The common simple motion, lowered without building its full AST; anything less
         common goes through :meth:`_motion` with the materialised statement."""
+        if self.unread_call is not None:
+            self._note_unread_call(stmt.span)
         if not self._lower_fast(stmt):
             self._motion(materialise(stmt))
 
@@ -179,6 +184,7 @@ class Motions(InlineForms):
     # ---- motions
     def _motion(self, stmt: MotionStmt) -> None:
         self.motion_count += 1
+        self._note_unread_call(stmt.span)
         base = _BASE_MOTION.get(stmt.keyword)
         if base is None:
             raise self._error(
@@ -610,6 +616,24 @@ class Motions(InlineForms):
             "frame": state.frame,
             "span": stmt.span,
         }
+
+    def _note_unread_call(self, span: ir.SourceSpan) -> None:
+        """A warning at the first motion after a call of a routine olp did not read (another
+        module's, an ``EXT`` one): olp checks the motion with the tool, base and speeds it
+        knows, and the posts write those again before it, so a routine that sets them (a
+        ``MoveSettings(nBase, nTool)``) is overridden in the output: the user must know."""
+        unread = self.unread_call
+        if unread is None:
+            return
+        self.unread_call = None
+        name, line = unread
+        message = (
+            f"the call of {name} at line {line} runs a routine olp did not read: olp assumes it "
+            "leaves $TOOL, $BASE and the motion settings as they were, checks this motion with "
+            "those, and the output sets them again before it; if "
+            f"{name} sets them, give olp its module or set them in this program after the call"
+        )
+        self._note(span, message)
 
     def _note_default_speed(self, stmt: MotionStmt) -> None:
         if not self.state.vel_cp_set:
