@@ -320,12 +320,9 @@ def comment_texts(text: str) -> list[tuple[int, str]]:
 
 def decoded(data: bytes) -> str:
     """A file's text as olp reads it: UTF-8, else Windows-1252, else Latin-1."""
-    for encoding in ("utf-8", "cp1252"):
-        try:
-            return data.decode(encoding)
-        except UnicodeDecodeError:
-            continue
-    return data.decode("latin-1")
+    from olp.frontends.krl import _decode
+
+    return _decode(data)
 
 
 def _unwritten_routines(text: str, src: str, result: object) -> list[tuple[int, int]]:
