@@ -126,8 +126,14 @@ def resolve(
     index = flat = 0
     while index < len(nodes):
         node = nodes[index]
-        if isinstance(node, RuntimeMove):
-            step, found = _runtime_step(flat, node, station, state)
+        if isinstance(node, RuntimeMove) or (
+            state.unknown_start is not None and isinstance(node, MOTION_TYPES)
+        ):
+            # one step: a run-time motion, or a motion whose start only the run time knows
+            if isinstance(node, RuntimeMove):
+                step, found = _runtime_step(flat, node, station, state)
+            else:
+                step, found = _after_unknown_start(flat, node, station, state)
             items.append(step)
             diags.extend(found)
             index, flat = index + 1, flat + 1
@@ -148,13 +154,6 @@ def resolve(
                 diags.extend(found)
             index, flat = index + 1, flat + len(node)
             progress.advance(len(node))
-            continue
-        if state.unknown_start is not None and isinstance(node, MOTION_TYPES):
-            step, found = _after_unknown_start(flat, node, station, state)
-            items.append(step)
-            diags.extend(found)
-            index, flat = index + 1, flat + 1
-            progress.advance(1)
             continue
         if isinstance(node, LinearPath):
             found_items, found = _resolve_path(flat, node, station, state)
