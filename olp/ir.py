@@ -650,10 +650,20 @@ class WaitInput:
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Call:
-    """Call a subprogram or controller routine by name (e.g. ``SprayOn``)."""
+    """Call a subprogram or controller routine by name (e.g. ``SprayOn``).
+
+    ``may_move``: the routine's body is not part of the program (another module's, an
+    external one) and may move the robot, so the next motion starts where olp does not know
+    (:mod:`olp.passes.resolve` checks its target, not its path, and does not time it). The
+    KRL frontend sets it for a call of a routine it did not read; a RoboDK-style call of a
+    controller program from the DSL does not (RoboDK's own simulation does not move the robot
+    for one either), and neither does a split program's call of its parts (each is checked
+    on its own).
+    """
 
     name: str
     args: tuple[str, ...] = ()
+    may_move: bool = False
     span: SourceSpan = GENERATED
     kind: Literal["call"] = field(default="call", init=False)
 

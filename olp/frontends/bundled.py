@@ -36,7 +36,11 @@ class KrlOptions:
     ``DEFDAT name PUBLIC`` whose ``GLOBAL`` declarations the program may use (a shared
     ``Positions.dat``); ``data_lists_from``: a folder whose public data lists are all read (a
     controller's ``R1`` folder). KRL's visibility rules:
-    :func:`olp.frontends.krl.data.visible_globals`.
+    :func:`olp.frontends.krl.data.visible_globals`. ``calls_keep_settings``: names (or
+    ``fnmatch`` patterns, case-insensitive) of routines olp does not read that the user vouches
+    leave the motion settings and the robot's position as they were (``SprayOn``, ``Grip*``);
+    a call of any other unread routine may set them and move the robot
+    (:meth:`olp.frontends.krl.lower._Lowering._unread_call`).
     """
 
     config_dat: str | os.PathLike[str] | KrlData | None = field(
@@ -65,9 +69,23 @@ class KrlOptions:
             metavar="DIR",
         ),
     )
+    calls_keep_settings: tuple[str, ...] = field(
+        default=(),
+        metadata=cli(
+            "--call-keeps-settings",
+            "a routine olp does not read (another module's) that leaves $TOOL, $BASE, the motion "
+            "settings and the robot where they were: a name or a pattern such as 'Spray*' "
+            "(repeatable; without it a motion after such a call runs with the controller's "
+            "settings and is not checked)",
+            metavar="NAME",
+            parse=tuple,
+            repeatable=True,
+        ),
+    )
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "data_lists", tuple(self.data_lists))
+        object.__setattr__(self, "calls_keep_settings", tuple(self.calls_keep_settings))
 
 
 class KrlFrontend:
@@ -88,6 +106,7 @@ class KrlFrontend:
             config_dat=options.config_dat,
             data_lists=options.data_lists,
             data_lists_from=options.data_lists_from,
+            calls_keep_settings=options.calls_keep_settings,
         )
         remarks = tuple(
             Diagnostic("warning", "krl_note", note.message, note.span) for note in result.notes

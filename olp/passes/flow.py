@@ -158,9 +158,14 @@ def _textual_previous(program: ir.Program) -> dict[int, int]:
 
 
 def _moves(node: Any) -> bool:
-    """Whether ``node`` moves the robot: a motion, or one to a run-time target (a start of
-    the next motion that olp cannot know, :func:`_check_from`)."""
-    return ir.is_motion(node) or isinstance(node, ir.RuntimeMove)
+    """Whether ``node`` moves the robot: a motion, one to a run-time target or a call that
+    may move it (:attr:`olp.ir.Call.may_move`): a start of the next motion that olp cannot
+    know, :func:`_check_from`."""
+    return ir.is_motion(node) or isinstance(node, ir.RuntimeMove) or _may_move(node)
+
+
+def _may_move(node: Any) -> bool:
+    return isinstance(node, ir.Call) and node.may_move
 
 
 def flow_pass(compiled: CompiledProgram, options: Any) -> CompiledProgram:

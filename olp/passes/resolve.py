@@ -19,7 +19,8 @@
   its target is checked (reach, configuration, joint limits, in the solution nearest the last
   known joints) and its path is not: a warning (``unknown_start``), end joints but no path.
   ``skip_unreachable`` skips such a motion as any; ``fallback_joint`` has nothing to change
-  there (:func:`_after_unknown_start`).
+  there (:func:`_after_unknown_start`). So is the motion after a call of a routine that may
+  move the robot (:attr:`olp.ir.Call.may_move`: one olp did not read).
 
 The result is a :class:`olp.compiled.CompiledProgram`: the program, one step per instruction
 (end joints, resolved tool and frame, sampled joint path of a motion) and the diagnostics.
@@ -42,6 +43,7 @@ from olp.geometry import interpolate_poses, inv, pose_distance, pose_from
 from olp.ir import (
     MOTION_TYPES,
     ArcOrientation,
+    Call,
     CartesianTarget,
     CircularMove,
     Configuration,
@@ -175,6 +177,8 @@ def resolve(
             items.append(step)
             diags.extend(found)
         else:
+            if isinstance(node, Call) and node.may_move:
+                state.unknown_start = node
             items.append(Step(index=flat, instruction=node))
         index, flat = index + 1, flat + 1
         progress.advance(1)
@@ -207,12 +211,22 @@ def _runtime_step(
         frame = ins.frame if ins.frame.pose is not None else station.frame(ins.frame)
         found = _lookup_errors(index, ins, tool, frame)
     why = f" ({ins.reason})" if ins.reason else ""
-    message = (
-        f"{_MOVE_WORDS[ins.motion]} to a target known only when the program runs{why}: olp "
-        "cannot check it (reach, joint limits, singularities, collisions) or time it; the "
-        "cycle time leaves it out"
+    what = (
+        "that runs with settings the controller holds at run time"
+        if ins.controller_settings
+        else "to a target known only when the program runs"
     )
-    found.append(Diagnostic("warning", "runtime_target", message, ins.span, index))
+    message = (
+        f"{_MOVE_WORDS[ins.motion]} {what}{why}: olp cannot check it (reach, joint limits, "
+        "singularities, collisions) or time it; the cycle time leaves it out"
+    )
+    hint = (
+        "if a routine it names leaves the tool, base, speeds and the robot as they were, name "
+        "it with --call-keeps-settings (KRL)"
+        if ins.controller_settings and "did not read" in ins.reason
+        else None
+    )
+    found.append(Diagnostic("warning", "runtime_target", message, ins.span, index, hint=hint))
     state.unknown_start = ins
     return Step(index=index, instruction=ins, tool=tool, frame=frame), found
 
@@ -220,7 +234,8 @@ def _runtime_step(
 def _after_unknown_start(
     index: int, ins: JointMove | LinearMove | CircularMove, station: Station, state: _State
 ) -> tuple[Step, list[Diagnostic]]:
-    """The first motion after a run-time motion: it starts where olp does not know, so its
+    """The first motion after a run-time motion (or a call that may move the robot,
+    :attr:`olp.ir.Call.may_move`): it starts where olp does not know, so its
     path cannot be checked (a line, an arc, the joint-space path) nor timed; its target still
     is: reachable, in the configuration the target asks for, within the joint limits (a
     joint move to it from the last known joints, whose path is then dropped). The joints
@@ -258,10 +273,17 @@ def _after_unknown_start(
         return Step(index=index, instruction=ins, tool=tool, frame=frame), found
     state.q = path[-1].copy()
     kind = _MOVE_WORDS[ins.kind]
+    if isinstance(runtime, Call):
+        where = (
+            f"the call of {runtime.name} at line {runtime.span.line} leaves the robot (a routine "
+            "olp did not read, which may move it)"
+        )
+    else:
+        where = f"the motion to a run-time target at line {runtime.span.line} ends"
     message = (
-        f"this {kind} starts where the motion to a run-time target at line "
-        f"{runtime.span.line} ends, which olp cannot know: only its target is checked (reach, "
-        "joint limits, in the solution nearest the last known joints); its path (singularities, "
+        f"this {kind} starts where {where}, which olp cannot know: only its target is checked "
+        "(reach, joint limits, in the solution nearest the last known joints); its path "
+        "(singularities, "
         "collisions) and its time are not, and the cycle time leaves it out"
     )
     found.append(Diagnostic("warning", "unknown_start", message, ins.span, index))
@@ -297,12 +319,13 @@ def _node_of(item: Item) -> Node:
 class _State:
     """Where resolving stands: ``q`` (dof,) rad, the joints after the last motion resolved;
     ``unknown_start``: the run-time motion (:class:`~olp.ir.RuntimeMove`) the robot went to
-    since, whose end olp cannot know (the next motion's start), else None."""
+    since, or the call of a routine that may move it (:attr:`olp.ir.Call.may_move`), whose end
+    olp cannot know (the next motion's start), else None."""
 
     q: FloatArray
     robot: Robot
     opts: ResolveOptions
-    unknown_start: RuntimeMove | None = None
+    unknown_start: RuntimeMove | Call | None = None
 
 
 def _error(kind: str, message: str, index: int, ins: Instruction, **kw: object) -> Diagnostic:

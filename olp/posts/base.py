@@ -598,7 +598,11 @@ class Post:
         :attr:`KINDS`) from a template folder that says so (``runtime_targets: true``: a copy
         made before olp wrote them would leave the motion out); a circular one as any arc.
         What the language can name as a target is the brand's :meth:`check_instruction`."""
-        what = f"a {ins.motion} move to a target known only at run time (line {ins.span.line})"
+        what = (
+            f"a {ins.motion} move with the controller's settings (line {ins.span.line})"
+            if ins.controller_settings
+            else f"a {ins.motion} move to a target known only at run time (line {ins.span.line})"
+        )
         if "runtime_move" not in self.KINDS:
             why = f": {self.RUNTIME_REFUSAL}" if self.RUNTIME_REFUSAL else ""
             msg = f"the {self.LANGUAGE} post cannot write {what}{why}"
@@ -614,11 +618,18 @@ class Post:
             )
             return [_error("runtime_target", msg, step, hint=hint)]
         if ins.controller_settings and self.VERBATIM is None:
+            why = f" ({ins.reason})" if ins.reason else ""
             msg = (
-                f"the {self.LANGUAGE} post cannot write {what}: it runs with the settings that a "
-                "statement of another language, kept as written, sets before it"
+                f"the {self.LANGUAGE} post cannot write {what}: it runs with the settings the "
+                f"source's controller holds there{why}, which only a program in that language "
+                "keeps"
             )
-            return [_error("runtime_target", msg, step)]
+            hint = (
+                "set the tool, base and speeds in the source before this motion (an inline form "
+                "does); for a call of a routine that leaves them and the robot as they were, "
+                "name it with --call-keeps-settings"
+            )
+            return [_error("runtime_target", msg, step, hint=hint)]
         if ins.relative is not None and ins.relative not in self.RUNTIME_RELATIVE:
             return [_error("runtime_target", _relative_refusal(self.LANGUAGE, what, ins), step)]
         return self._arc_checks(step, ins) if ins.motion == "circular" else []

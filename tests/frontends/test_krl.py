@@ -149,7 +149,7 @@ def test_names_that_start_with_keywords_are_names() -> None:
     assert not result.ignored  # assignments are kept (and evaluated), the FOR is a block
     assert [i.kind for i in result.program.instructions] == ["assign"] * 3 + ["for", "call", "wait"]
     assert [without_span(i) for i in result.program if i.kind in ("call", "wait")] == [
-        ir.Call(name="LIN_ON"),
+        ir.Call(name="LIN_ON", may_move=True),  # another module's: it may move the robot
         ir.Wait(seconds=6.0),
     ]
 
@@ -323,8 +323,8 @@ def test_io_waits_and_calls() -> None:
         ir.WaitInput(index=1, value=True),
         ir.WaitInput(index=2, value=False),
         ir.WaitInput(index=3, value=False),
-        ir.Call(name="SprayOn"),
-        ir.Call(name="TCP_On", args=("1", '"a, b"', "#X")),
+        ir.Call(name="SprayOn", may_move=True),
+        ir.Call(name="TCP_On", args=("1", '"a, b"', "#X"), may_move=True),
     ]
     assert [i.span.line for i in result.program] == list(range(2, 10))
 

@@ -163,5 +163,13 @@ def test_settings_no_motion_runs_with_are_a_warning_not_a_silent_drop(
     src.write_text(TOOL_SETUP_MODULE, encoding="latin-1")
     result = olp.build(station, src, post="kuka", collisions=None)  # type: ignore[arg-type]
     lost = [d for d in result.diagnostics if "no motion of the program runs with" in d.message]
-    # the settings before the LIN are written with it; those after it are not written at all
-    assert [(d.severity, d.span.line) for d in lost] == [("warning", 8), ("warning", 10)]
+    # the settings before the LIN are written with it; the one after it is kept as written
+    # (it is the module's effect on its caller); the one inside the IF, a block olp lowered
+    # already, is not in the output, with a warning
+    assert [(d.severity, d.span.line) for d in lost] == [("warning", 10)]
+    nodes = list(result.compiled.program)
+    lin = next(i for i, node in enumerate(nodes) if isinstance(node, ir.LinearMove))
+    after = [n for n in nodes[lin + 1 :] if isinstance(n, ir.Verbatim)]
+    assert [(n.text, n.native_only, n.span.line) for n in after] == [
+        ("$BASE = $NULLFRAME", True, 8)
+    ]

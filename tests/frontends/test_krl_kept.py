@@ -193,23 +193,30 @@ def test_a_held_pos_act_is_stale_after_a_motion(tmp_path: Path) -> None:
     assert "pAct" in moved.reason
 
 
-@pytest.mark.parametrize(
-    "between",
-    [
-        "IF $IN[3] THEN\nPTP XHOME\nENDIF\n",
-        "GO_SOMEWHERE()\n",  # another module's routine may move it
-    ],
-)
-def test_a_held_pos_act_is_stale_after_anything_that_may_move(tmp_path: Path, between: str) -> None:
-    """After a block or a call that may move the robot, pAct is known only when the program
-    runs: a motion to a run-time target with the settings in effect (its WITH's), which the
-    KRL post writes before it (before, olp stopped: the posts wrote settings only before the
-    motions they modelled)."""
+def test_a_held_pos_act_is_stale_after_a_block_that_may_move(tmp_path: Path) -> None:
+    """After a block that may move the robot, pAct is known only when the program runs: a
+    motion to a run-time target with the settings in effect (its WITH's), which the KRL post
+    writes before it (before, olp stopped: the posts wrote settings only before the motions
+    they modelled)."""
     path = tmp_path / "here.src"
-    path.write_text(HERE_PROGRAM.format(between=between))
+    path.write_text(HERE_PROGRAM.format(between="IF $IN[3] THEN\nPTP XHOME\nENDIF\n"))
     program = load_krl(path, CORPUS / "System" / "$config.dat").program
     (moved,) = [n for n in program if isinstance(n, ir.RuntimeMove)]
     assert moved.motion == "joint" and moved.speed.joint == pytest.approx(0.1)
+
+
+def test_after_a_call_that_may_move_a_with_motion_is_kept_as_written(tmp_path: Path) -> None:
+    """Another module's routine may move the robot and set any setting: the SPTP with its
+    WITH runs with the settings the controller then holds for all it does not set itself, so
+    it is kept as written (WITH and all), and the PTP after it runs with the controller's
+    settings too (nothing set them again)."""
+    path = tmp_path / "here.src"
+    path.write_text(HERE_PROGRAM.format(between="GO_SOMEWHERE()\n"))
+    program = load_krl(path, CORPUS / "System" / "$config.dat").program
+    kept = [n.text for n in program if isinstance(n, ir.Verbatim)]
+    assert kept == ["SPTP pAct WITH $VEL_AXIS[1]=10, $VEL_AXIS[2]=10"]
+    (home,) = [n for n in program if isinstance(n, ir.RuntimeMove)]
+    assert home.controller_settings and "GO_SOMEWHERE at line 4" in home.reason
 
 
 @pytest.mark.parametrize("again", ["$TOOL = $NULLFRAME", "$TOOL = TOOL_DATA[1]"])

@@ -414,7 +414,10 @@ def test_calls_whose_motions_differ_are_written_out_with_constant_arguments() ->
     assert [m.span.line for m in motions] == [13, 14, 13, 14]  # the callee's lines
     assert [m.zone.radius for m in motions] == [0.002, 0.0, 0.002, 0.0]
     assert result.program.instructions[-1] == ir.Call(
-        name="gripper_open", args=("1", "", "#FAST"), span=ir.SourceSpan("t.src", 6, 1, 6, 25)
+        name="gripper_open",
+        args=("1", "", "#FAST"),
+        may_move=True,
+        span=ir.SourceSpan("t.src", 6, 1, 6, 25),
     )
     # LIN target goes to another point at each call: one routine text cannot say both, so
     # approach is written out at its calls (the DECL of line 9 is kept as an ir.Declare)

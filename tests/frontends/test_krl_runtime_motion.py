@@ -101,18 +101,22 @@ def test_a_rel_motion_by_run_time_offsets_stays_as_written(config: KrlData) -> N
     assert [n.text for n in kept] == ["LIN_REL pOff"] and runtime(result) == []
 
 
-def test_the_motion_right_after_a_run_time_bas_runs_with_the_controller_settings(
+def test_the_motions_after_a_run_time_bas_run_with_the_controller_settings(
     config: KrlData,
 ) -> None:
-    """BAS with a run-time value changes the settings behind the output's back: the motion
-    right after it runs with them (a run-time motion with ``controller_settings``: nothing is
-    written between the BAS and it); a second motion still relying on them is an error."""
+    """BAS with a run-time value changes the settings behind the output's back: the motions
+    after it that rely on them run with them (run-time motions with ``controller_settings``:
+    the output writes no setting of olp's before them), the second too (before: an error,
+    the rule covered only the motion right after the BAS)."""
     body = ("DECL REAL v", "DECL E6POS xPath[2]", "DECL INT i", *SETUP, "v = $OV_PRO")
     result = lower(*body, "i = $IN[1]", "BAS(#PTP_PARAMS, v)", "PTP xPath[i]", config=config)
     (ptp,) = runtime(result)
-    assert ptp.controller_settings and "BAS(#PTP_PARAMS, v)" in ptp.reason
-    with pytest.raises(ParseError, match=r"BAS\(#PTP_PARAMS\) at line 12 sets them"):
-        lower(*body, "i = $IN[1]", "BAS(#PTP_PARAMS, v)", "PTP xPath[i]", HOME, config=config)
+    assert ptp.controller_settings and "BAS(#PTP_PARAMS) at line 12" in ptp.reason
+    again = lower(*body, "i = $IN[1]", "BAS(#PTP_PARAMS, v)", "PTP xPath[i]", HOME, config=config)
+    first, second = runtime(again)
+    assert first.controller_settings and second.controller_settings
+    assert second.span.line == 14 and "BAS(#PTP_PARAMS) at line 12" in second.reason
+    assert not list(again.program.motions())[1:]  # only SETUP's HOME is modelled
 
 
 PENDANT_HOME = (
@@ -134,7 +138,7 @@ def test_the_pendant_home_without_config_dat_runs_with_the_controller_settings()
     result = lower(*PENDANT_HOME, *AGAIN)
     (home,) = runtime(result)
     assert home.controller_settings and home.motion == "joint" and home.span.line == 6
-    assert "$config.dat" in home.reason and "BAS (#PTP_PARAMS,100 )" in home.reason
+    assert "$config.dat" in home.reason and "BAS(#PTP_PARAMS) at line 4" in home.reason
     kept = [n for n in result.program if isinstance(n, ir.Verbatim)]
     assert [n.text for n in kept] == ["BAS (#PTP_PARAMS,100 )", "$H_POS=XHOME"]
     assigned = [n for n in result.program if isinstance(n, ir.Assign)]
@@ -142,8 +146,8 @@ def test_the_pendant_home_without_config_dat_runs_with_the_controller_settings()
         ir.Name(name="PDAT_ACT", span=assigned[0].target.span),
         ir.Name(name="FDAT_ACT", span=assigned[1].target.span),
     ]
-    with pytest.raises(ParseError, match="cannot tell which motion settings"):
-        lower(*PENDANT_HOME, HOME)
+    (_, second) = runtime(lower(*PENDANT_HOME, HOME))  # (before: an error)
+    assert second.controller_settings and "BAS(#PTP_PARAMS) at line 4" in second.reason
 
 
 def test_with_config_dat_the_pendant_home_is_modelled() -> None:
@@ -210,8 +214,9 @@ def test_a_home_fold_of_several_bas_runs_with_the_controller_settings() -> None:
         "BAS (#FRAMES )",
         "RuntimeMove",
     ]
-    with pytest.raises(ParseError, match=r"\(\$ACC_AXIS, \$APO.CDIS, \$BASE, \$TOOL\): BAS"):
-        lower(*HOME_FOLD, "PTP {A1 0,A2 -90,A3 90,A4 0,A5 30,A6 0} C_PTP")
+    after = runtime(lower(*HOME_FOLD, "PTP {A1 0,A2 -90,A3 90,A4 0,A5 30,A6 0} C_PTP"))
+    assert [m.controller_settings for m in after] == [True, True]
+    assert "BAS(#FRAMES) at line 7" in after[1].reason
 
 
 CP_FORM = (
@@ -227,18 +232,21 @@ def test_a_lin_form_after_the_home_fold_sets_all_it_uses_and_is_modelled() -> No
     """After the HOME fold the axis speeds and accelerations stay the run-time BAS's; a LIN
     does not run with them (``$VEL_AXIS``/``$ACC_AXIS`` are PTP settings), and its inline form
     set its tool, base, path speed and distance: an ordinary linear move (before: an error
-    naming ``BAS(#PTP_PARAMS)``). A PTP after it still runs with the unknown axis speeds."""
+    naming ``BAS(#PTP_PARAMS)``). A PTP after it still runs with the unknown axis speeds: the
+    controller's."""
     result = lower(*CP_FORM, *PENDANT_HOME, *LIN_FORM)
     (lin,) = [m for m in result.program.motions() if isinstance(m, ir.LinearMove)]
     assert lin.speed.linear == pytest.approx(0.5) and lin.zone.radius == pytest.approx(0.02)
     assert lin.tool.number == 1 and lin.frame.number == 1
-    with pytest.raises(ParseError, match=r"\(\$ACC_AXIS, \$VEL_AXIS\): BAS\(#PTP_PARAMS\)"):
-        lower(*CP_FORM, *PENDANT_HOME, *LIN_FORM, "PTP XPick")
+    ptp = runtime(lower(*CP_FORM, *PENDANT_HOME, *LIN_FORM, "PTP XPick"))[-1]
+    assert ptp.controller_settings and ptp.span.line == 14
+    assert "BAS(#PTP_PARAMS) at line 7" in ptp.reason
 
 
-def test_a_lin_after_the_home_fold_that_sets_nothing_names_what_it_lacks() -> None:
-    with pytest.raises(ParseError, match=r"\(\$APO.CDIS, \$BASE, \$TOOL, the speed\): BAS\(#PTP"):
-        lower(*CP_FORM, *PENDANT_HOME, "LIN XPick C_DIS")
+def test_a_lin_after_the_home_fold_that_sets_nothing_runs_with_the_controller_settings() -> None:
+    *_, lin = runtime(lower(*CP_FORM, *PENDANT_HOME, "LIN XPick C_DIS"))
+    assert lin.motion == "linear" and lin.controller_settings and lin.zone == ir.FINE
+    assert "BAS(#PTP_PARAMS) at line 7" in lin.reason
 
 
 @pytest.mark.parametrize(

@@ -111,7 +111,7 @@ def test_the_inline_form_record_of_a_missing_file_keeps_its_bas() -> None:
     body = ("PDAT_ACT = PDEFAULT", "FDAT_ACT = FPOUNCE", "BAS(#PTP_PARAMS,100)", "PTP XPOUNCE")
     result = lower(*body, dat=module)
     (ptp,) = runtime(result)
-    assert ptp.controller_settings and "BAS(#PTP_PARAMS,100) (line 4)" in ptp.reason
+    assert ptp.controller_settings and "BAS(#PTP_PARAMS) at line 4" in ptp.reason
     (kept,) = [n for n in nodes(result) if isinstance(n, ir.Verbatim)]
     assert kept.text == "BAS(#PTP_PARAMS,100)" and "FPOUNCE is not declared" in kept.reason
     assigned = [n.target for n in nodes(result) if isinstance(n, ir.Assign)]
@@ -136,10 +136,13 @@ PALLET = (
 
 def test_a_base_set_from_an_undeclared_name_is_kept_and_leaves_the_base_unknown() -> None:
     """``$BASE = palletBase[nActive].frame``: kept as written; a motion before the base is set
-    again is an error naming that line (olp could check nothing of it); after ``$BASE =
-    BASE_DATA[1]`` the motions are lowered as usual."""
-    with pytest.raises(ParseError, match=r"\$BASE is set at line 4 from a value"):
-        lower(*PALLET, "$VEL.CP = 0.2", HOME)
+    again runs with the base the controller then holds (a run-time motion with the
+    controller's settings, naming that line: olp checks nothing of it; before, an error);
+    after ``$BASE = BASE_DATA[1]`` the motions are lowered as usual."""
+    held = lower(*PALLET, "$VEL.CP = 0.2", HOME)
+    (move,) = [n for n in nodes(held) if isinstance(n, ir.RuntimeMove)]
+    assert move.controller_settings and "$BASE is set at line 4 from a value" in move.reason
+    assert not list(held.program.motions())
     result = lower(*PALLET, "$BASE = BASE_DATA[1]", "$VEL.CP = 0.2", HOME)
     kept = [n for n in nodes(result) if isinstance(n, ir.Verbatim)]
     assert [n.text for n in kept] == ["$BASE = palletBase[nActive].frame"]

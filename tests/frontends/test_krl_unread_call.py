@@ -1,13 +1,18 @@
 """A call of a routine olp did not read (another module's, an EXT one) may set the tool, base or
-speeds; olp checks the next motion with the settings it knows and the posts write those again
-before it, overriding what the routine set: the first motion after such a call carries a
-warning that says so (it used to pass without a word)."""
+speeds and may move the robot. The motions after it that rely on those settings run with the
+controller's (the KRL output writes none of olp's before them: it used to write its own, which
+overrode what the routine set, with only a warning); the settings olp absorbed before the call
+are written before it (the routine may move with them; they used to move after it); a _REL
+motion after it is relative to where the routine left the robot; the next motion's path is not
+checked. A user can vouch for routines that leave all that alone (``calls_keep_settings``)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 import olp
+from olp import ir
+from olp.frontends.bundled import KrlOptions
 
 STATION = Path(__file__).resolve().parents[2] / "stations" / "kr6_milling_cell.yaml"
 
@@ -18,6 +23,23 @@ $VEL.CP = 0.2
 SetFrames(1, 2)
 PTP {A1 10, A2 -90, A3 90, A4 0, A5 45, A6 0}
 LIN {X 500, Y 0, Z 600, A 0, B 90, C 0}
+LIN_REL {Z 50}
+END
+"""
+
+SETTLED = """DEF cell( )
+$BASE = BASE_DATA[1]
+$TOOL = TOOL_DATA[1]
+$VEL.CP = 0.2
+PTP {A1 0, A2 -90, A3 90, A4 0, A5 45, A6 0}
+Gripper(1)
+$BASE = BASE_DATA[1]
+$TOOL = TOOL_DATA[1]
+$VEL.CP = 0.2
+$ORI_TYPE = #VAR
+BAS(#VEL_PTP, 50)
+BAS(#ACC_PTP, 50)
+LIN {X 500, Y 0, Z 400, A 0, B 90, C 0}
 END
 """
 
@@ -33,21 +55,79 @@ END
 """
 
 
-def _warnings(tmp_path: Path, text: str) -> list[olp.Diagnostic]:
+def _build(
+    tmp_path: Path, text: str, post: str = "kuka", keeps: tuple[str, ...] = ()
+) -> olp.BuildResult:
     source = tmp_path / "cell.src"
     source.write_text(text)
-    result = olp.build(olp.load_station(STATION), source, post="kuka", collisions=None)
-    return [
-        d for d in result.diagnostics if d.severity == "warning" and "did not read" in d.message
+    options = KrlOptions(calls_keep_settings=keeps)
+    station = olp.load_station(STATION)
+    return olp.build(station, source, post=post, program_options=options, collisions=None)
+
+
+def _written(result: olp.BuildResult) -> list[str]:
+    return [line.strip() for line in result.files["cell.src"].splitlines()]
+
+
+def test_the_motions_after_an_unread_routine_run_with_the_controller_settings(
+    tmp_path: Path,
+) -> None:
+    result = _build(tmp_path, CELL)
+    assert result.ok, [d.format() for d in result.diagnostics]
+    moves = [n for n in result.compiled.program if isinstance(n, ir.RuntimeMove)]
+    assert [(m.span.line, m.motion, m.controller_settings) for m in moves] == [
+        (6, "joint", True),
+        (7, "linear", True),
+        (8, "linear", True),
     ]
+    assert all("SetFrames at line 5" in m.reason for m in moves)
+    assert moves[2].relative == "base"  # from where the routine left the robot
+    lines = _written(result)
+    call = lines.index("SetFrames(1, 2)")
+    assert lines[call - 1] == "$VEL.CP = 0.2"  # the routine may move with it
+    after = lines[call + 1 :]
+    assert after[:3] == [
+        "PTP {A1 10, A2 -90, A3 90, A4 0, A5 45, A6 0}",
+        "LIN {X 500, Y 0, Z 600, A 0, B 90, C 0}",
+        "LIN_REL {Z 50}",
+    ]
+    assert not any(line.startswith(("$BASE", "$TOOL", "$VEL")) for line in after)
 
 
-def test_the_first_motion_after_an_unread_routine_says_what_olp_assumed(tmp_path: Path) -> None:
-    (warning,) = _warnings(tmp_path, CELL)
-    assert warning.span is not None and warning.span.line == 6  # the PTP right after the call
-    assert "SetFrames at line 5" in warning.message
-    assert "$TOOL, $BASE" in warning.message
+def test_a_motion_that_sets_what_it_uses_is_modelled_but_its_start_is_unknown(
+    tmp_path: Path,
+) -> None:
+    """Tool, base, speeds and orientation type set again after the call: a modelled motion
+    (its target checked), whose start is where the routine left the robot, so its path is
+    not."""
+    result = _build(tmp_path, SETTLED)
+    assert result.ok, [d.format() for d in result.diagnostics]
+    assert [m.span.line for m in result.compiled.program.motions()] == [5, 13]
+    (start,) = [d for d in result.diagnostics if d.kind == "unknown_start"]
+    assert start.span is not None and start.span.line == 13
+    assert "call of Gripper at line 6" in start.message
 
 
-def test_a_call_of_the_modules_own_routine_needs_no_such_warning(tmp_path: Path) -> None:
-    assert _warnings(tmp_path, OWN) == []
+def test_a_vouched_routine_leaves_settings_and_position_alone(tmp_path: Path) -> None:
+    result = _build(tmp_path, CELL.replace("LIN_REL {Z 50}\n", ""), keeps=("set*",))
+    assert result.ok, [d.format() for d in result.diagnostics]
+    assert [n for n in result.compiled.program if isinstance(n, ir.RuntimeMove)] == []
+    assert [m.span.line for m in result.compiled.program.motions()] == [3, 6, 7]
+    assert not [d for d in result.diagnostics if d.kind == "unknown_start"]
+
+
+def test_another_language_refuses_what_the_controller_holds_and_says_how_to_vouch(
+    tmp_path: Path,
+) -> None:
+    result = _build(tmp_path, CELL.replace("LIN_REL {Z 50}\n", ""), post="abb")
+    refused = [d for d in result.diagnostics if d.severity == "error"]
+    assert refused and all(d.kind == "runtime_target" for d in refused)
+    assert "SetFrames at line 5" in refused[0].message
+    assert refused[0].hint is not None and "--call-keeps-settings" in refused[0].hint
+
+
+def test_a_call_of_the_modules_own_routine_holds_nothing(tmp_path: Path) -> None:
+    result = _build(tmp_path, OWN)
+    assert result.ok, [d.format() for d in result.diagnostics]
+    assert [n for n in result.compiled.program if isinstance(n, ir.RuntimeMove)] == []
+    assert not [d for d in result.diagnostics if d.kind == "unknown_start"]

@@ -29,6 +29,7 @@ import olp
 from olp import ir
 from olp.compiled import CompiledProgram, Step
 from olp.diagnostics import Diagnostic
+from olp.frontends.bundled import KrlOptions
 from olp.kinematics.base import turn_variants
 from olp.kinematics.configuration import satisfies
 from olp.posts import find_post
@@ -428,7 +429,9 @@ def _split_post(tmp_path: Path, limit: int) -> Post:
 
 def test_split_modules(tmp_path: Path) -> None:
     st = olp.load_station(CELL)
-    result = olp.build(st, PICK, post=str(_split_post(tmp_path, 3).manifest.folder))
+    post = str(_split_post(tmp_path, 3).manifest.folder)
+    options = KrlOptions(calls_keep_settings=("Gripper_Check",))  # an I/O routine
+    result = olp.build(st, PICK, post=post, program_options=options)
     assert result.ok
     files = rapid(dict(result.files))
     assert list(files) == [

@@ -12,6 +12,7 @@ import pytest
 import olp
 from olp import ir
 from olp.cli import main
+from olp.frontends.bundled import KrlOptions
 from olp.posts import find_post
 
 REPO = Path(__file__).resolve().parents[2]
@@ -31,7 +32,10 @@ PATH = (
     "LIN {X 520,Y 0,Z 400,A 0,B 90,C 0}",
     "END",
 )
-"""A run-time LIN right after a call (line 12): the call may have changed every setting."""
+"""A run-time LIN right after a call (line 12) of an I/O routine the build vouches for
+(``calls_keep_settings``): the post writes every setting again after a call, as after any
+statement it does not model. (Without the vouch the LIN runs with the controller's settings:
+tests/frontends/test_krl_unread_call.py.)"""
 
 
 @pytest.fixture(scope="module")
@@ -44,7 +48,8 @@ def build(
 ) -> olp.api.BuildResult:
     path = tmp_path / "path.src"
     path.write_text("\n".join(lines) + "\n")
-    return olp.build(station, path, post=post, collisions=None)
+    options = KrlOptions(calls_keep_settings=("SprayOff",))
+    return olp.build(station, path, post=post, program_options=options, collisions=None)
 
 
 def errors(result: olp.api.BuildResult) -> list[tuple[str, int | None, str]]:

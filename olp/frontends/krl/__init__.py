@@ -206,6 +206,7 @@ def parse_krl(
     config: KrlData | None = None,
     shared: Sequence[KrlData] = (),
     fast_path: bool = True,
+    calls_keep_settings: Sequence[str] = (),
 ) -> KrlResult:
     """Parse KRL source ``text`` (a ``.src`` file's content) and lower its first DEF.
 
@@ -213,7 +214,9 @@ def parse_krl(
     ``$config.dat`` (:func:`load_config_dat`); ``shared``: other modules' data lists, whose
     ``GLOBAL`` names of a ``PUBLIC`` list the program sees
     (:func:`olp.frontends.krl.data.visible_globals`). ``fast_path=False`` reads every line with
-    the full grammar (same result, slower; for tests and benchmarks).
+    the full grammar (same result, slower; for tests and benchmarks). ``calls_keep_settings``:
+    routines olp does not read that leave the settings and the robot as they were
+    (:class:`olp.frontends.bundled.KrlOptions`).
 
     Raises :class:`olp.errors.ParseError` (with span and source line) for text that is not KRL
     olp understands; no other exception escapes for bad input.
@@ -224,7 +227,9 @@ def parse_krl(
     try:
         with gc_paused():
             module = parse_module(source, fast=fast_path)
-            return lower_module(module, sources, filename, dat, config, shared)
+            return lower_module(
+                module, sources, filename, dat, config, shared, tuple(calls_keep_settings)
+            )
     except RecursionError:
         span = ir.SourceSpan(source.filename, 1, 1)
         raise source.error("the program is nested too deeply to read", span) from None
@@ -235,12 +240,14 @@ def load_krl(
     config_dat: str | os.PathLike[str] | KrlData | None = None,
     data_lists: Sequence[str | os.PathLike[str] | KrlData] = (),
     data_lists_from: str | os.PathLike[str] | None = None,
+    calls_keep_settings: Sequence[str] = (),
 ) -> KrlResult:
     """Read a ``.src`` file, the ``.dat`` beside it (:func:`find_dat`), an optional
     ``$config.dat`` (a path, or one read before with :func:`load_config_dat`) and other
     modules' data lists: ``data_lists`` (each must be ``PUBLIC``: :func:`load_data_list`) and
     the ``PUBLIC`` ones found under the folder ``data_lists_from`` (:func:`find_data_lists`).
-    The module's own ``.dat`` is never read twice.
+    The module's own ``.dat`` is never read twice. ``calls_keep_settings``: see
+    :func:`parse_krl`.
 
     Files are UTF-8, else Windows-1252 (what KUKA controllers write), else Latin-1.
     Raises :class:`olp.errors.UsageError` if a file cannot be read and
@@ -252,7 +259,14 @@ def load_krl(
     dat_path = find_dat(path)
     dat = None if dat_path is None else parse_dat(_read(dat_path, "data list"), os.fspath(dat_path))
     shared = _shared_lists(data_lists, data_lists_from, dat_path)
-    return parse_krl(_read(path, "KRL"), os.fspath(path), dat=dat, config=config, shared=shared)
+    return parse_krl(
+        _read(path, "KRL"),
+        os.fspath(path),
+        dat=dat,
+        config=config,
+        shared=shared,
+        calls_keep_settings=calls_keep_settings,
+    )
 
 
 def load_config_dat(path: str | os.PathLike[str]) -> KrlData:

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from olp import ir
 from olp.frontends.krl.ast import (
     Aggregate,
     Assign,
@@ -26,6 +25,7 @@ from olp.frontends.krl.state import (
     SYSTEM_REASONS,
     WRITTEN,
     Core,
+    Held,
 )
 from olp.frontends.krl.values import (
     Unknown,
@@ -109,11 +109,8 @@ class InlineForms(Core):
         before it, or the BAS would read whatever the controller held."""
         self._write_absorbed_records(stmt, command)
         self._keep(stmt, f"BAS #{command} with a value known only at run time ({reason})")
-        kept = self.out[-1]
-        assert isinstance(kept, ir.Verbatim)
-        self.kept_bas = (kept, self.state)  # the motion right after it may run with it
         ambiguous: dict[str, str] | None = getattr(self, "ambiguous", None)
-        why = f"BAS(#{command}) at line {stmt.span.line} sets them from run-time values"
+        why = Held(f"BAS(#{command}) at line {stmt.span.line} sets them from run-time values")
         for field_name in _BAS_SETS[command]:
             if ambiguous is not None:
                 ambiguous[field_name] = why

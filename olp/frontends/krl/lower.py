@@ -62,13 +62,14 @@ from olp.frontends.krl.flow import (
     to_expr,
 )
 from olp.frontends.krl.module_data import with_module_data
-from olp.frontends.krl.motion import Motions
+from olp.frontends.krl.motion import Motions, RuntimeStart
 from olp.frontends.krl.native import INI_TITLE, native_reason
 from olp.frontends.krl.routines import PendingCall, assemble, moves, typed_params
 from olp.frontends.krl.rows import build_instructions
 from olp.frontends.krl.state import (
     DEFAULT_VEL_CP,
     Context,
+    Held,
     KrlResult,
     Pending,
     PendingRows,
@@ -164,9 +165,8 @@ class _Lowering(Motions, Events):
         self.past: set[str] = set()  # counters of unrolled FOR loops (see flow.PastFor)
         # statements that set motion settings (absorbed into the motions) since the last motion
         self.unwritten: list[Stmt] = []
-        # a call of a routine olp did not read since the last motion: (its name, its line)
-        self.unread_call: tuple[str, int] | None = None
         self.unwritten_at: list[tuple[list[Any], int]] = []  # each one's output list, position
+        self.live_outs: list[list[Any]] = []  # the output lists this lowering is nested in
         self.folds: list[str] = []  # the titles of the source's folds open here, innermost last
         self._blocks: dict[str, Callable[[Block], None]] = {
             "IF": self._if,
@@ -319,8 +319,14 @@ class _Lowering(Motions, Events):
             self.unwritten_at.append((self.out, len(self.out)))
 
     def report_unwritten_settings(self) -> None:
-        """Warn about the settings no motion of the program follows (a routine that sets
-        ``$BASE`` and ``$TOOL`` for its callers, written as a program of its own)."""
+        """The settings no motion of the program follows (a routine that sets ``$BASE`` and
+        ``$TOOL`` for its callers, written as a program of its own): kept as written where
+        they stand, for the KRL post (they matter to what runs after the module: its caller);
+        one inside a block olp lowered already is left out with a warning."""
+        self._keep_unwritten(
+            "sets motion settings after the module's last motion: kept as written for what "
+            "runs after it (a caller)"
+        )
         for stmt in self.unwritten:
             self._ignore(
                 stmt,
@@ -381,9 +387,15 @@ class _Lowering(Motions, Events):
             )
 
     def _signal(self, stmt: SignalDecl) -> None:
+        """A SIGNAL declared in a routine: the KRL post writes the program's uses of it by name
+        (``GRIP = TRUE``), so it writes the declaration as written too (it was absorbed without
+        a trace, and the output used a name it never declared); other posts use the I/O by
+        number and leave it out with a warning."""
         reason = self.data.signal(stmt, self.variables.declare)
         if reason is not None:
             self._ignore(stmt, reason)
+        else:
+            self._keep_krl_only(stmt, "a SIGNAL declaration: other posts name the I/O by number")
 
     # ---- calls
     def _call(self, stmt: CallStmt) -> None:
@@ -399,11 +411,34 @@ class _Lowering(Motions, Events):
             )
         elif name in _IGNORED_CALLS:
             self._keep(stmt, _IGNORED_CALLS[name])
-        else:
-            self.motion_count += 1  # another module's routine may move the robot
-            self.unread_call = (stmt.name, stmt.span.line)
+        elif self.ctx.keeps_settings(stmt.name):
             args = tuple("" if arg is None else self.sources.snippet(arg.span) for arg in stmt.args)
             self.out.append(ir.Call(name=stmt.name, args=args, span=stmt.span))
+        else:
+            self._unread_call(stmt)
+
+    def _unread_call(self, stmt: CallStmt) -> None:
+        """A call of a routine olp did not read (another module's, an ``EXT`` one): it may set
+        any motion setting (a ``MoveSettings(nBase, nTool)``) and may move the robot. So the
+        settings olp absorbed since the last motion are kept as written before it (the routine
+        may move with them: :meth:`_keep_unwritten`); every setting is then held by the
+        controller (:class:`~olp.frontends.krl.state.Held`: a motion that runs with one before
+        the program sets it again runs with the controller's, and the output writes none of
+        olp's before it, :meth:`_controller_settings_motion`); the robot is where olp does not
+        know (a _REL motion after it is a run-time one), and the next motion's path is not
+        checked (:attr:`olp.ir.Call.may_move`)."""
+        self.motion_count += 1
+        line = stmt.span.line
+        self._keep_unwritten(
+            f"sets motion settings before the call of {stmt.name} (line {line}), a routine olp "
+            "did not read, which may move the robot with them"
+        )
+        why = Held(f"the call of {stmt.name} at line {line} runs a routine olp did not read")
+        for name in _STATE_FIELDS:
+            self.ambiguous[name] = why
+        self.track.lose(RuntimeStart(f"{why}, which may move the robot"))
+        args = tuple("" if arg is None else self.sources.snippet(arg.span) for arg in stmt.args)
+        self.out.append(ir.Call(name=stmt.name, args=args, may_move=True, span=stmt.span))
 
     def _inline(self, routine: Routine, stmt: CallStmt) -> None:
         """Lower the body of a DEF of this module in place of its call."""
@@ -432,12 +467,14 @@ class _Lowering(Motions, Events):
         self.returned, self.exiting, self.loop_depth, self.loops = None, None, 0, []
         self.routine, self.jumped = RoutineJumps.of(routine.body), None
         caller_out, self.out = self.out, []
+        self.live_outs.append(caller_out)
         try:
             self.first_pass(routine.body)
             self.lower_body(routine.body)
             self._join_returns(routine)
         finally:
             lowered, self.out = self.out, caller_out
+            self.live_outs.pop()
             finals = self.variables.pop()
             self.call_stack.pop()
             self.returned, self.exiting, self.loop_depth, self.loops, self.routine = saved[:5]
@@ -716,6 +753,7 @@ class _Lowering(Motions, Events):
         child.past = self.past
         child.in_block = self.in_block + 1
         child.folds = list(self.folds)
+        child.live_outs = [*self.live_outs, self.out]
         if not probe:
             child.ignored, child.notes, child.status_turn = (
                 self.ignored,
@@ -954,6 +992,7 @@ def lower_module(
     dat: KrlData | None,
     config: KrlData | None,
     shared: Sequence[KrlData] = (),
+    calls_keep_settings: tuple[str, ...] = (),
 ) -> KrlResult:
     """Lower the first DEF of ``module`` and the module's other routines: each called one at
     every call, kept as a routine where the calls agree (:mod:`olp.frontends.krl.routines`).
@@ -966,6 +1005,7 @@ def lower_module(
     ordered = routines if main is None else [main, *(r for r in routines if r is not main)]
     table = {r.name.upper(): r for r in ordered}
     ctx = Context(sources, table, src, dat, config, MAX_LOWERED_STATEMENTS, shared)
+    ctx.calls_keep_settings = calls_keep_settings
     lowering = _Lowering(ctx, State(), _variables(values, ctx, main))
     if main is not None:
         lowering.routine = RoutineJumps.of(main.body)

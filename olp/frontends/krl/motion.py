@@ -30,6 +30,7 @@ from olp.frontends.krl.inline import InlineForms
 from olp.frontends.krl.state import (
     DEFAULT_VEL_CP,
     Cartesian,
+    Held,
     Pending,
     PendingRows,
     Target,
@@ -72,12 +73,27 @@ _USED_SETTINGS: dict[str, frozenset[str]] = {
 }
 """The motion settings (fields of :class:`~olp.frontends.krl.state.State`) a motion of each
 kind runs with, besides ``cdis_mm`` when it is approximated (see :meth:`Motions._unsettled`)."""
+_WITH_SETS: dict[tuple[str, bool], frozenset[str]] = {
+    ("$VEL_AXIS[]", True): frozenset({"vel_axis", "speed"}),
+    ("$ACC_AXIS[]", True): frozenset({"acc_axis"}),
+    ("$VEL", False): frozenset({"speed"}),
+    ("$VEL.CP", False): frozenset({"speed"}),
+    ("$TOOL", True): frozenset({"tool"}),
+    ("$TOOL", False): frozenset({"tool"}),
+    ("$BASE", True): frozenset({"frame"}),
+    ("$BASE", False): frozenset({"frame"}),
+    ("$APO", True): frozenset({"cdis_mm"}),
+    ("$APO", False): frozenset({"cdis_mm"}),
+    ("$ORI_TYPE", False): frozenset({"ori_type"}),
+    ("$CIRC_TYPE", False): frozenset({"circ_type"}),
+}
+"""(a WITH item's target, whether the motion is a PTP) -> the settings of
+:data:`_USED_SETTINGS` it sets for that motion: the axis speeds are a PTP's speed, the path
+speed a LIN's or CIRC's (:meth:`Motions._unsettled`)."""
 
 
 class Motions(InlineForms):
     """Motion statements -> IR motions, tracking where the robot goes."""
-
-    unread_call: tuple[str, int] | None  # set by the statement walk (lower._Lowering._call)
 
     # ---- the fast path
     def _lin_rows(self, rows: LinRows) -> None:
@@ -88,7 +104,6 @@ class Motions(InlineForms):
                 self.lower_statement(motion)  # type: ignore[attr-defined]
             return
         self.ctx.remaining -= len(rows)  # what lower_statement spends per line
-        self._note_unread_call(rows.span)
         self._after_kept_settings(rows.span)
         state = self.state
         zone = 0.0 if state.cdis_mm is None else state.cdis_mm / 1000.0
@@ -125,8 +140,6 @@ class Motions(InlineForms):
     def _fast_motion(self, stmt: FastMotion) -> None:
         """The common simple motion, lowered without building its full AST; anything less
         common goes through :meth:`_motion` with the materialised statement."""
-        if self.unread_call is not None:
-            self._note_unread_call(stmt.span)
         if not self._lower_fast(stmt):
             self._motion(materialise(stmt))
 
@@ -184,7 +197,6 @@ class Motions(InlineForms):
     # ---- motions
     def _motion(self, stmt: MotionStmt) -> None:
         self.motion_count += 1
-        self._note_unread_call(stmt.span)
         base = _BASE_MOTION.get(stmt.keyword)
         if base is None:
             raise self._error(
@@ -340,47 +352,57 @@ class Motions(InlineForms):
         base, path speed and distance again (``BAS(#CP_PARAMS, 2)`` with known data), is
         lowered as any: the axis speeds that BAS left unknown are not its settings. The speed
         is one setting in olp (:class:`olp.ir.Speed`): what sets either part of it counts for
-        both (conservative: a LIN right after a run-time ``BAS(#VEL_PTP)`` still stops)."""
+        both (conservative: a LIN right after a run-time ``BAS(#VEL_PTP)`` still stops). What
+        the motion's own WITH sets (a spline inline form's ``$TOOL = STOOL2(FP1)``, ...) is not
+        ambiguous for it."""
         ambiguous: dict[str, str] = getattr(self, "ambiguous", {})
         base = _BASE_MOTION.get(stmt.keyword, "PTP")
         used = _USED_SETTINGS[base] | ({"cdis_mm"} if stmt.approx else set())
+        for assignment in stmt.with_clause or ():
+            used = used - _WITH_SETS.get((assignment.target.key, base == "PTP"), frozenset())
         return {name: why for name, why in ambiguous.items() if name in used}
 
     def _controller_settings_motion(self, stmt: MotionStmt, unsettled: dict[str, str]) -> bool:
-        """The motion right after the BAS commands kept as written (their values known only at
-        run time, a ``$config.dat`` olp was not given among them: the pendant's
-        ``FDAT_ACT=FHOME``, ``BAS(#PTP_PARAMS,100)``, ``PTP XHOME``, or the fold KSS writes as
-        ``PDAT_ACT=PDEFAULT``, ``BAS(#PTP_DAT)``, ``FDAT_ACT=FHOME``, ``BAS(#FRAMES)``,
-        ``BAS(#VEL_PTP,100)``, ``PTP XHOME``), in the same straight stretch, when those BAS
-        are all that leave its settings (``unsettled``, :meth:`_unsettled`) unknown: a
-        :class:`~olp.ir.RuntimeMove` that runs with the controller's settings
-        (``controller_settings``: the KRL post writes no setting before it, so the BAS's
-        hold), its target an expression. The statements olp absorbed into the motion settings
-        since the first of those BAS (``BAS(#VEL_PTP,100)``, a ``$VEL.CP``) are kept as written
-        where they stand: the output writes settings only before the motions that use them,
-        and this one writes none, so without them it would run without what they set. Not for
-        a _REL or WITH motion. Returns whether it lowered ``stmt`` (else the caller's error
-        stands)."""
-        bas = self._kept_bas_before()
+        """A motion whose ambiguous settings (``unsettled``, :meth:`_unsettled`) are all held
+        by the controller (:class:`~olp.frontends.krl.state.Held`: a BAS given run-time values,
+        the pendant's ``FDAT_ACT=FHOME``, ``BAS(#PTP_PARAMS,100)``, ``PTP XHOME`` without the
+        ``$config.dat``; ``$BASE`` set from a run-time value; a call of a routine olp did not
+        read, ``MoveSettings(nBase, nTool)``): a :class:`~olp.ir.RuntimeMove` that runs with
+        the controller's settings (``controller_settings``: the KRL post writes no setting
+        before it, so those the source's statements set hold), its target an expression, a
+        _REL motion's offsets or a partial target's components taken from the start at run
+        time (``relative``: the tool and base they refer to are the controller's too). So does
+        every motion after it until the program sets those settings again.
+
+        The statements olp absorbed into the motion settings since the last motion (a
+        ``$VEL.CP``, ``BAS(#VEL_PTP,100)``) are kept as written where they stand
+        (:meth:`_keep_unwritten`): the output writes settings only before the motions that use
+        them, and this one writes none, so without them it would run without what they set.
+        One with a WITH or a CA is kept as written (:meth:`_keep_controller_motion`). Returns
+        whether it lowered ``stmt`` (else the caller's error stands)."""
         base = _BASE_MOTION.get(stmt.keyword)
-        from_bas = all(why.startswith("BAS(#") for why in unsettled.values())
-        latest = self.kept_bas is not None and self.kept_bas[0] is bas
-        expected = 2 if base == "CIRC" else 1
-        if bas is None or base is None or not (from_bas and latest):
+        if base is None or not all(isinstance(why, Held) for why in unsettled.values()):
             return False
+        expected = 2 if base == "CIRC" else 1
         if len(stmt.targets) != expected:
             return False
-        if stmt.keyword.endswith("_REL") or stmt.with_clause or stmt.angle is not None:
-            return False
+        if stmt.with_clause or stmt.angle is not None:
+            return self._keep_controller_motion(stmt, unsettled)
+        relative = self._start_relative(stmt, base)
+        if stmt.keyword.endswith("_REL") and relative is None:
+            return False  # an offset olp refuses anyway: the usual error
         self.motion_count += 1
         runtime = self._runtime_target(stmt)
-        self._keep_absorbed_since(self._first_kept_bas())
-        why = f"its settings are what {bas.text} (line {bas.span.line}) sets at run time"
+        self._keep_unwritten(
+            "sets motion settings before a motion that runs with the controller's settings "
+            "(olp writes none before it)"
+        )
+        why = "; ".join(sorted(set(unsettled.values())))
         if stmt.approx:
             self._note(
                 stmt.span,
-                f"{' '.join(stmt.approx)} after {bas.text}: the approximation distance is the "
-                "controller's, unknown to olp; written as an exact stop",
+                f"{' '.join(stmt.approx)} with the controller's settings: the approximation "
+                "distance is unknown to olp; written as an exact stop",
             )
         self.out.append(
             ir.RuntimeMove(
@@ -389,7 +411,7 @@ class Motions(InlineForms):
                 via=self._target_expr(stmt.targets[0]) if base == "CIRC" else None,
                 reason=why if runtime is None else f"{runtime}; {why}",
                 controller_settings=True,
-                relative=self._partial_kind(stmt, base),
+                relative=relative,
                 span=stmt.span,
             )
         )
@@ -398,49 +420,51 @@ class Motions(InlineForms):
         )
         return True
 
-    def _kept_bas_before(self) -> ir.Verbatim | None:
-        """The BAS kept as written (one given run-time values) that the next motion follows
-        in the same straight stretch, or None."""
-        for node in reversed(self.out):
-            if isinstance(node, (ir.Label, ir.RuntimeMove, *ir.BLOCK_TYPES)):
-                return None
-            if isinstance(node, ir.Verbatim) and node.reason.startswith("BAS #"):
-                return node
-        return None
+    def _keep_controller_motion(self, stmt: MotionStmt, unsettled: dict[str, str]) -> bool:
+        """A motion with a WITH (or a CA) that runs with settings the controller holds
+        (:meth:`_controller_settings_motion`): kept as written, WITH and all
+        (:class:`~olp.ir.RuntimeMove` has no WITH), for the KRL post; olp checks nothing of it
+        and the next motion starts where olp does not know."""
+        self.motion_count += 1
+        self._keep_unwritten(
+            "sets motion settings before a motion that runs with the controller's settings "
+            "(olp writes none before it)"
+        )
+        why = "; ".join(sorted(set(unsettled.values())))
+        self._keep(stmt, f"it runs with settings the controller holds ({why})")
+        self._note(
+            stmt.span,
+            f"{stmt.keyword} with settings the controller holds ({why}): kept as written and "
+            "not checked (reach, limits, collisions, time)",
+        )
+        self.track.lose(
+            RuntimeStart(f"the {stmt.keyword} at line {stmt.span.line} runs with unknown settings")
+        )
+        return True
 
-    def _first_kept_bas(self) -> int:
-        """The position in the output of the first BAS kept as written in the straight stretch
-        that ends here (a motion is never between two: :meth:`_after_kept_settings`)."""
-        first = len(self.out)
-        for k in range(len(self.out) - 1, -1, -1):
-            node = self.out[k]
-            if isinstance(node, (ir.Label, ir.RuntimeMove, *ir.BLOCK_TYPES)):
-                break
-            if isinstance(node, ir.Verbatim) and node.reason.startswith("BAS #"):
-                first = k
-        return first
-
-    def _keep_absorbed_since(self, first: int) -> None:
-        """Keep as written, where they stand, the statements absorbed into the motion settings
-        (``unwritten``) after position ``first`` of this output (see
-        :meth:`_controller_settings_motion`); they are no longer waiting for a motion. One a
-        kept BAS already had written (a data record it reads) is not written twice."""
+    def _keep_unwritten(self, reason: str) -> None:
+        """Keep as written, where they stand and for the KRL post only
+        (:attr:`olp.ir.Verbatim.native_only`), the statements olp absorbed into the motion
+        settings since the last motion (``unwritten``): something that runs with the
+        controller's settings comes next (a call of a routine olp did not read, a motion with
+        the controller's settings, the end of the module), before which the output writes none
+        of olp's. Only those in an output list still being built (``live_outs``: this
+        lowering's and those it is nested in); one inside a block already lowered stays
+        waiting for a motion, or is reported at the end (:meth:`report_unwritten_settings`).
+        One a kept BAS already wrote (a data record it reads) is not written twice."""
         unwritten: list[Any] = getattr(self, "unwritten", [])
         positions: list[tuple[list[Any], int]] = getattr(self, "unwritten_at", [])
-        written = {getattr(node, "span", None) for node in self.out[first:]}
-        since = [
-            k
-            for k, (out, at) in enumerate(positions)
-            if out is self.out and at > first and unwritten[k].span not in written
-        ]
-        for k in reversed(since):  # from the back: the positions before stay valid
-            self._keep(
-                unwritten[k],
-                "sets motion settings before a motion that runs with the "
-                "controller's settings (olp writes none before it)",
-            )
-            self.out.insert(positions[k][1], self.out.pop())
-            del unwritten[k], positions[k]
+        live = [*getattr(self, "live_outs", []), self.out]
+        for k in range(len(unwritten) - 1, -1, -1):  # from the back: earlier positions hold
+            out, at = positions[k]
+            if not any(out is candidate for candidate in live):
+                continue
+            stmt = unwritten.pop(k)
+            del positions[k]
+            if any(getattr(node, "span", None) == stmt.span for node in out[at:]):
+                continue
+            self._keep_krl_only(stmt, reason)
+            out.insert(at, self.out.pop())
 
     def _keep_runtime_motion(self, stmt: MotionStmt, base: str, reason: str) -> None:
         """Keep a _REL motion by run-time offsets as written (:class:`~olp.ir.Verbatim`, with a
@@ -616,24 +640,6 @@ class Motions(InlineForms):
             "frame": state.frame,
             "span": stmt.span,
         }
-
-    def _note_unread_call(self, span: ir.SourceSpan) -> None:
-        """A warning at the first motion after a call of a routine olp did not read (another
-        module's, an ``EXT`` one): olp checks the motion with the tool, base and speeds it
-        knows, and the posts write those again before it, so a routine that sets them (a
-        ``MoveSettings(nBase, nTool)``) is overridden in the output: the user must know."""
-        unread = self.unread_call
-        if unread is None:
-            return
-        self.unread_call = None
-        name, line = unread
-        message = (
-            f"the call of {name} at line {line} runs a routine olp did not read: olp assumes it "
-            "leaves $TOOL, $BASE and the motion settings as they were, checks this motion with "
-            "those, and the output sets them again before it; if "
-            f"{name} sets them, give olp its module or set them in this program after the call"
-        )
-        self._note(span, message)
 
     def _note_default_speed(self, stmt: MotionStmt) -> None:
         if not self.state.vel_cp_set:
@@ -841,6 +847,7 @@ class Motions(InlineForms):
         unverified); the next motion without WITH gets a note saying so. ``runtime``: why the
         target is known only at run time (then a :class:`~olp.ir.RuntimeMove`), or None."""
         saved = self.state
+        ambiguous = dict(getattr(self, "ambiguous", {}))  # the WITH's values are this motion's
         self.in_with = True  # a $BASE or $TOOL set from a run-time value cannot be kept here
         try:
             for assignment in stmt.with_clause:
@@ -853,6 +860,8 @@ class Motions(InlineForms):
         else:
             self._runtime_motion(stmt, base, runtime)
         self.state = saved
+        if hasattr(self, "ambiguous"):
+            self.ambiguous = ambiguous
         if (during.tool, during.frame) != (saved.tool, saved.frame):
             line = stmt.span.line
             self.track.lose_cartesian(f"the WITH at line {line} set $TOOL/$BASE for that motion")

@@ -15,6 +15,7 @@ tens of thousands of them.
 from __future__ import annotations
 
 import dataclasses
+import fnmatch
 import functools
 import math
 import os
@@ -108,6 +109,19 @@ class State:
 
 ORI_TYPES = frozenset({"VAR", "CONSTANT", "JOINT"})
 CIRC_TYPES = frozenset({"BASE", "PATH"})
+
+
+class Held(str):
+    """Why a motion setting is ambiguous, when it is because the controller holds a value only
+    the run time knows: a BAS given run-time values, ``$BASE``/``$TOOL`` set from a run-time
+    value (both kept as written), a call of a routine olp did not read (which may set any of
+    them). A motion that runs with such a setting runs with the controller's settings, which
+    the output leaves as the source does (:meth:`olp.frontends.krl.motion.Motions.
+    _controller_settings_motion`); one that differs between paths olp lowered is not held
+    (olp absorbed the statements that set it, so it cannot leave it to the controller). A
+    ``str`` so that the reasons read as any other."""
+
+    __slots__ = ()
 
 
 @dataclass(slots=True)
@@ -326,9 +340,18 @@ class Context:
         self.src_name = os.path.basename(src)
         self.files = [src, *(d.filename for d in (dat, config, *self.shared) if d is not None)]
         self._where = self._describe_files(src)
+        # routines olp did not read that the user vouches leave settings and position alone
+        self.calls_keep_settings: tuple[str, ...] = ()
         # > 0 while a FOR body is tried with its counter unknown: a motion to a run-time
         # target then fails the try, so that the loop is unrolled and its targets known
         self.probing_for = 0
+
+    def keeps_settings(self, name: str) -> bool:
+        """Whether the user vouched that the unread routine ``name`` leaves the motion settings
+        and the robot's position as they were (``calls_keep_settings``: names or ``fnmatch``
+        patterns, compared without case as KRL names are)."""
+        key = name.upper()
+        return any(fnmatch.fnmatchcase(key, p.upper()) for p in self.calls_keep_settings)
 
     def _describe_files(self, src: str) -> str:
         dat = (
@@ -473,8 +496,6 @@ class Core:
         self._reported: set[tuple[Any, ...]] = set()
         self.motion_count = 0  # motions lowered so far (by this lowering)
         self.here_vars: dict[str, tuple[str, int]] = {}  # name -> ($POS_ACT..., motion_count)
-        # the last BAS kept as written (run-time values) and the motion settings when it ran
-        self.kept_bas: tuple[ir.Verbatim, State] | None = None
         # the last assignment of each inline-form record olp absorbed into the motions, for a
         # BAS kept as written: None where it cannot be written back alone (a member's),
         # WRITTEN once the output holds the record's value
@@ -891,7 +912,7 @@ class Core:
             return False
         assert isinstance(known, Unknown) and isinstance(stmt, Assign)
         self._keep(stmt, f"{name} is set from a value known only at run time ({known.reason})")
-        ambiguous[setting] = (
+        ambiguous[setting] = Held(
             f"{name} is set at line {stmt.span.line} from a value olp does not know "
             f"({known.reason})"
         )

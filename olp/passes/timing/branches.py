@@ -321,7 +321,8 @@ class SegmentTimer:
         ends = np.searchsorted(self.motions, bounds) - 1
         stops = self.motions[ends[ends >= 0]]
         timed = self.compiled
-        if any(not self.compiled.steps[i].instruction.zone.is_fine for i in stops.tolist()):
+        instructions = (self.compiled.steps[i].instruction for i in stops.tolist())
+        if any(not getattr(ins, "zone", ir.FINE).is_fine for ins in instructions):  # (a call)
             timed = time_program(self.compiled, *self._timing(), stops=stops)
         # else: every run already starts and ends at a stop; the timing pass's times hold
         totals = np.concatenate([[0.0], np.cumsum(_durations(timed))])
@@ -365,11 +366,11 @@ class SegmentTimer:
 
     def _lead_in(self, entry: int, span: SourceSpan) -> Any:
         """What brings the robot to ``entry`` before a run (not counted): a joint move to its
-        joints, or the run-time motion itself (the run then starts where olp does not know,
-        as after it in the text)."""
+        joints, or the run-time motion (or call that may move the robot) itself (the run then
+        starts where olp does not know, as after it in the text)."""
         if entry != START:
             motion = self.compiled.steps[entry].instruction
-            if isinstance(motion, ir.RuntimeMove):
+            if isinstance(motion, ir.RuntimeMove) or _may_move(motion):
                 return motion
         return ir.JointMove(target=ir.JointTarget(joints=self._joints(entry)), span=span)
 
@@ -399,8 +400,9 @@ def _size(nodes: Sequence[Any]) -> int:
 
 def motion_indices(program: ir.Program) -> NDArray[np.int64]:
     """The instruction indices of the motions of ``program``, ascending (a toolpath's rows
-    as one range, not one by one), motions to run-time targets included: the robot's position
-    after one is a position of the walk (olp does not know where; :meth:`SegmentTimer.time`
+    as one range, not one by one), motions to run-time targets and calls that may move the robot
+    (:attr:`olp.ir.Call.may_move`) included: the robot's position after one is a position of
+    the walk (olp does not know where; :meth:`SegmentTimer.time`
     times what follows it as the text does, from an unknown start)."""
     parts, cursor = [], 0
     for node in leaves(program.instructions):
@@ -408,7 +410,7 @@ def motion_indices(program: ir.Program) -> NDArray[np.int64]:
             parts.append(np.arange(cursor, cursor + len(node)))
             cursor += len(node)
             continue
-        if ir.is_motion(node) or isinstance(node, ir.RuntimeMove):
+        if ir.is_motion(node) or isinstance(node, ir.RuntimeMove) or _may_move(node):
             parts.append(np.array([cursor]))
         cursor += 1
     return np.concatenate(parts).astype(np.int64) if parts else np.zeros(0, dtype=np.int64)
@@ -848,3 +850,7 @@ def _note(compiled: CompiledProgram, paths: PathTimes) -> Diagnostic:
 
 def _is_flow(node: Any) -> bool:
     return isinstance(node, ir.FLOW_TYPES)
+
+
+def _may_move(node: object) -> bool:
+    return isinstance(node, ir.Call) and node.may_move
