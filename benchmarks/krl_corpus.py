@@ -20,11 +20,18 @@ Each file lands in one class:
 
 * ``build``: no error diagnostic;
 * ``program``: stopped on program-level diagnostics only (unreachable, limits, ...);
-* ``syntax``: stopped on an :class:`olp.errors.OlpError` (olp cannot read or lower something),
-  counted by construct (the keyword at the error, or the block it sits in);
+* ``invalid``: stopped on an :class:`olp.errors.OlpError` whose ``code`` is
+  :data:`olp.errors.INVALID_KRL`: the file is not KRL (a bare name, END closing a DEFFCT,
+  ``=`` in a condition, ...), the controller refuses it too; counted by its message;
+* ``syntax``: stopped on any other :class:`olp.errors.OlpError` (olp cannot read or lower
+  something), counted by construct (the keyword at the error, or the block it sits in);
 * ``post``: read, but the post cannot write something the program says (control flow, a line
   kept verbatim for another language), counted by the post's diagnostic kind;
 * ``crash``: any other exception (a bug in olp).
+
+The summary gives ``build_or_program`` (the share of files that build or stop only for
+program-level reasons) and ``build_program_or_invalid`` (the same with the files that are not
+KRL: olp told the user precisely what is wrong, and no reader of KRL could do more).
 
 Besides, it counts statements of the ``.src`` olp read but did not put in the output and
 reported only at ``info`` level (``silent_drops``: "nothing dropped silently" wants 0), and, for
@@ -50,8 +57,11 @@ and the post writes it in its own spelling (a motion to ``XP1`` as ``PTP {A1 ..}
 expression with other parentheses, ``DECL INT a, b`` as two lines, and the inline forms'
 ``PDAT_ACT=PPDAT1``, ``FDAT_ACT=FP1``, ``BAS(#PTP_PARAMS,100)``, which become the
 ``$VEL_AXIS[i]``, ``$ACC_AXIS[i]``, ``$VEL.CP``, ``$APO.CDIS``, ``$TOOL`` and ``$BASE`` lines
-before the motion that runs with them); ``statements_lost_krl``: the rest, not in the output
-in any spelling (with ``-v``: the texts lost most often, and the rewritten ones by kind).
+before the motion that runs with them; and a statement the written ``.src`` says with its
+numbers otherwise spelt, ``WAIT SEC 0`` as ``WAIT SEC 0.000``, ``$VEL.CP=2`` as
+``$VEL.CP = 2.0``, or a declaration item by item, ``INT a, b`` as ``DECL INT a`` and ``DECL INT
+b``); ``statements_lost_krl``: the rest, not in the output in any spelling (with ``-v``: the
+texts lost most often, and the rewritten ones by kind).
 
 The last lines are ``name: value unit``.
 """
@@ -270,13 +280,20 @@ def count_text(text: str, src: str, result: object, count: TextCount) -> None:
     """KRL -> KRL by text: each statement of the source ``.src`` is ``found`` when the written
     ``.src`` holds a statement of the same normalised text (a multiset: each written statement
     matches once), else ``rewritten`` when olp lowered it (:func:`lowered_lines`, motions,
-    :data:`_REWRITTEN`), else ``lost``. DEF/DEFFCT/END/ENDFCT lines are counted apart."""
+    :data:`_REWRITTEN`) or when written statements left over say the same in another spelling
+    (numbers: ``WAIT SEC 0`` as ``WAIT SEC 0.000``, :func:`same_numbers`; a declaration:
+    ``INT a, b`` as ``DECL INT a`` and ``DECL INT b``, :func:`declared_items`), else ``lost``.
+    DEF/DEFFCT/END/ENDFCT lines are counted apart."""
     written: collections.Counter[str] = collections.Counter()
+    spelt: dict[str, str] = {}  # normalised text -> with its numbers in one spelling
     files = result.files  # type: ignore[attr-defined]
     for name in (n for n in files if n.lower().endswith(".src")):
-        written.update(normalised(line) for _, line in text_statements(files[name]))
+        for _, line in text_statements(files[name]):
+            written[normalised(line)] += 1
+            spelt.setdefault(normalised(line), same_numbers(line))
     lowered = lowered_lines(result.compiled.program, src)  # type: ignore[attr-defined]
-    for number, line in text_statements(text):
+    unmatched = []
+    for number, line in text_statements(text):  # first what is written as read
         key = normalised(line)
         routine = _ROUTINE_LINE.match(line) is not None
         count.routine_lines += routine
@@ -286,10 +303,63 @@ def count_text(text: str, src: str, result: object, count: TextCount) -> None:
             count.found += not routine
         elif routine:
             count.routine_lines_lost[key] += 1
-        elif number in lowered or _REWRITTEN.match(line) or _MOTION.match(line):
+        else:
+            unmatched.append((number, line))
+    # then what the post writes in its own spelling, from the written statements left over
+    numbers: collections.Counter[str] = collections.Counter()
+    for key, left in written.items():
+        numbers[spelt[key]] += left
+    for number, line in unmatched:
+        lowered_here = number in lowered or _REWRITTEN.match(line) or _MOTION.match(line)
+        if lowered_here or _respelt(numbers, line):
             count.rewritten[_kind(line)] += 1
         else:
-            count.lost[key] += 1
+            count.lost[normalised(line)] += 1
+
+
+def _respelt(left: collections.Counter[str], line: str) -> bool:
+    """Whether statements ``left`` over in the written file say ``line`` in another spelling
+    (they are taken): its numbers otherwise written, or its declaration item by item."""
+    return _take(left, [same_numbers(line)]) or _take(left, declared_items(line))
+
+
+def _take(left: collections.Counter[str], keys: list[str]) -> bool:
+    """Take one of each of ``keys`` from ``left`` if all are there (and not none)."""
+    need = collections.Counter(keys)
+    if not need or any(left[key] < number for key, number in need.items()):
+        return False
+    left.subtract(need)
+    return True
+
+
+_DECLARATION = re.compile(r"(?i)\s*(?:DECL\s+)?((?:GLOBAL\s+|CONST\s+)*[A-Za-z_$][\w$]*)\s+(.+)")
+_TOP_COMMA = re.compile(r",(?![^\[]*\])")
+"""A comma outside brackets: between a declaration's items, not in ``a[2,3]``."""
+
+
+def declared_items(line: str) -> list[str]:
+    """A declaration of items without values (``INT a, b``, ``DECL E6POS p1, p2``) as the
+    one-item declarations that say the same, in :func:`same_numbers` text (``DECL INT a``,
+    ``DECL INT b``); [] for any other line."""
+    match = _DECLARATION.fullmatch(line.strip())
+    if match is None or "=" in line or "{" in line:
+        return []
+    items = [item.strip() for item in _TOP_COMMA.split(match.group(2))]
+    return [same_numbers(f"DECL {match.group(1)} {item}") for item in items if item]
+
+
+_NUMBER = re.compile(r"(?i)(?<![\w$.])(\d+\.?\d*|\.\d+)(e[+-]?\d+)?(?![\w$.])")
+_QUOTED = re.compile(r'("[^"]*")')
+
+
+def same_numbers(line: str) -> str:
+    """:func:`normalised` text with each number in one spelling (``0.000`` and ``0`` as ``0``,
+    ``2.0`` as ``2``), strings left as they are: two statements that differ only in how their
+    numbers are written get the same text."""
+    parts = _QUOTED.split(line)
+    for index in range(0, len(parts), 2):  # the even parts are outside strings
+        parts[index] = _NUMBER.sub(lambda m: f"{float(m.group(0)):.12g}", parts[index])
+    return normalised("".join(parts))
 
 
 def _kind(line: str) -> str:
@@ -433,17 +503,31 @@ def run_backups(folder: Path, station_path: Path, post: str, verbose: bool) -> T
         mine = tally.classes - before
         total = sum(mine.values())
         if total:
+            known = mine["build"] + mine["program"] + mine["invalid"]
             print(
                 f"  backup {backup.name}: {total} files, {mine['build']} build, "
-                f"{mine['program']} program, {total - mine['build'] - mine['program']} other"
+                f"{mine['program']} program, {mine['invalid']} invalid KRL, "
+                f"{total - known} other"
             )
     return tally
 
 
+def _fault(message: str) -> str:
+    """What an invalid-KRL error says is wrong, without the file's own names and lines: its
+    words up to the first ':' or ';', numbers as ``N`` (``a bare name is not a KRL statement``,
+    ``the '(' at column N is not closed``)."""
+    return re.sub(r"\d+", "N", re.split(r"[:;] ", message, maxsplit=1)[0].strip())
+
+
 def _one(olp, path, station, options, post, tally, olp_error) -> str:  # type: ignore[no-untyped-def]
+    from olp.errors import INVALID_KRL
+
     try:
         result = olp.build(station, path, post=post, program_options=options, collisions=None)
     except olp_error as exc:
+        if exc.code == INVALID_KRL:  # not olp's gap: the controller refuses the file too
+            tally.constructs[f"invalid KRL: {_fault(exc.message)}"] += 1
+            return f"invalid: {exc.message} ({exc.span})"
         construct = construct_of(exc.message, exc.source_line)
         tally.constructs[construct] += 1
         return f"syntax: {construct} ({exc.span})"
@@ -543,10 +627,13 @@ def main() -> None:
     print(f"files: {total} files")
     print(f"build: {tally.classes['build']} files")
     print(f"program: {tally.classes['program']} files")
+    print(f"invalid: {tally.classes['invalid']} files")
     print(f"syntax: {tally.classes['syntax']} files")
     print(f"post: {tally.classes['post']} files")
     print(f"crash: {tally.classes['crash']} files")
     print(f"build_or_program: {100.0 * ok / max(total, 1):.1f} %")
+    ok_or_invalid = ok + tally.classes["invalid"]
+    print(f"build_program_or_invalid: {100.0 * ok_or_invalid / max(total, 1):.1f} %")
     print(f"silent_drops: {tally.silent_drops} statements")
     print(f"warned_drops: {tally.warned_drops} statements")
     for line in tally.unaccounted:

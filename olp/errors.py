@@ -23,6 +23,10 @@ class OlpError(Exception):
         The text of the offending line, for the caret display.
     hint:
         Optional advice for the user.
+    code:
+        A stable name of the fault for programs, or None. :data:`INVALID_KRL` marks a program
+        text the language itself refuses (the controller would too), as against one olp cannot
+        read yet; it is shown in brackets after the kind (``parse error[invalid_krl]:``).
     """
 
     kind = "error"
@@ -33,17 +37,21 @@ class OlpError(Exception):
         span: SourceSpan | None = None,
         source_line: str | None = None,
         hint: str | None = None,
+        code: str | None = None,
     ) -> None:
         super().__init__(message)
         self.message = message
         self.span = span
         self.source_line = source_line
         self.hint = hint
+        self.code = code
 
     def format(self) -> str:
-        """The message in compiler style: ``file:line:col: error: message``, line and caret."""
+        """The message in compiler style: ``file:line:col: error: message`` (``error[code]:``
+        when the error has a code, as diagnostics show their kind), line and caret."""
         where = f"{self.span}: " if self.span is not None else ""
-        lines = [f"{where}{self.kind}: {self.message}"]
+        kind = self.kind if self.code is None else f"{self.kind}[{self.code}]"
+        lines = [f"{where}{kind}: {self.message}"]
         if self.source_line is not None and self.span is not None:
             text = self.source_line.rstrip("\r\n").expandtabs(1)
             start = max(self.span.column - 1, 0)
@@ -60,6 +68,10 @@ class OlpError(Exception):
 
     def __str__(self) -> str:
         return self.format()
+
+
+INVALID_KRL = "invalid_krl"
+"""The :attr:`OlpError.code` of a KRL text that is not KRL: the controller refuses it too."""
 
 
 class ParseError(OlpError):

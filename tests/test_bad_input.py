@@ -139,6 +139,9 @@ CASES: dict[str, Case] = {
     "krl: syntax error": krl("LIN {X 500,Y 0 Z 500}", 2, r"prog\.src:3:16: parse error"),
     "krl: unknown statement": krl("FOO BAR", 2, r"prog\.src:3:5: parse error"),
     "krl: no END": krl(KRL_HEAD.encode(), 2, r"prog\.src:\d+:\d+: parse error"),
+    "krl: not KRL, a bare name": krl(
+        "TODO", 2, r"prog\.src:3:1: parse error\[invalid_krl\]: a bare name is not a KRL"
+    ),
     "krl: NUL byte": krl("LIN {X 500,\x00Y 0,Z 500}", 2, r"prog\.src:3:\d+: parse error"),
     "krl: huge line": krl("LIN {X " + "9" * 300_000 + "x}", 2, r"prog\.src:3:\d+: parse error"),
     "krl: a 300-digit target": krl(

@@ -70,6 +70,7 @@ from olp.frontends.krl.ast import (
 )
 from olp.frontends.krl.comments import attach
 from olp.frontends.krl.fast import RowReader, row_match, scan_line, signed_number
+from olp.frontends.krl.invalid import check_routines, refused
 from olp.resources import data_path
 
 _FAST_RUN = "\x00"
@@ -519,9 +520,13 @@ def parse_module(source: Source, fast: bool = True) -> Module:
 
     ``fast=False`` gives every line to lark (the reference the fast path is tested against).
     The source's comments are statements of the module, in place
-    (:func:`olp.frontends.krl.comments.attach`).
+    (:func:`olp.frontends.krl.comments.attach`). Text that is not KRL at all (a bare name, END
+    closing a DEFFCT, a routine defined twice, ...) gets a targeted error marked
+    :data:`~olp.errors.INVALID_KRL` (:mod:`olp.frontends.krl.invalid`).
     """
-    return attach(_parse_module(source, fast), source)
+    module = _parse_module(source, fast)
+    check_routines(module, source)
+    return attach(module, source)
 
 
 def _parse_module(source: Source, fast: bool) -> Module:
@@ -596,11 +601,15 @@ def gc_paused() -> Iterator[None]:
 
 
 def _syntax_error(exc: UnexpectedInput, source: Source) -> ParseError:
-    """A ParseError saying what was found where, and what the grammar expected there."""
+    """A ParseError saying what was found where, and what the grammar expected there; the
+    targeted one of :func:`~olp.frontends.krl.invalid.refused` where the text is not KRL."""
     found, expected, end = "end of file", set[str](), None
     line, column = exc.line, exc.column
     if isinstance(exc, UnexpectedToken):
         found, expected = _describe_token(exc.token), set(exc.expected)
+        invalid = refused(exc.token, expected, found, source)
+        if invalid is not None:
+            return invalid
         if exc.token.type != "$END" and exc.token.end_line == exc.token.line:
             end = exc.token.end_column
     elif isinstance(exc, UnexpectedCharacters):
