@@ -189,6 +189,19 @@ def test_the_krl_post_writes_the_programs_parameters(station: object, tmp_path: 
     assert shape(again) == shape(result.compiled.program)  # type: ignore[attr-defined]
 
 
+def test_an_array_parameter_stays_an_array(station: object, tmp_path: Path) -> None:
+    """``DEF Show(sText[]:IN)`` with ``DECL CHAR sText[]``: the open extent is kept in the IR
+    and written back (it was written ``sText:IN`` and ``DECL CHAR sText``: a scalar)."""
+    text = "DEF Show(sText[]:IN, nLen:IN)\nDECL CHAR sText[]\nINT nLen\nnLen = 2\nEND\n"
+    result = build(station, tmp_path, text, "Show.src")
+    assert result.ok, [d.format() for d in result.diagnostics if d.severity == "error"]
+    (text_param, _) = result.compiled.program.params  # type: ignore[attr-defined]
+    assert text_param.dims == (None,)
+    lines = result.files["Show.src"].splitlines()
+    assert lines[2] == "DEF Show(sText[]:IN, nLen:IN)"
+    assert lines[4:6] == ["DECL CHAR sText[]", "DECL INT nLen"]
+
+
 @pytest.mark.parametrize("post", ["abb", "ur", "fanuc"])
 def test_other_posts_refuse_a_program_with_parameters(
     station: object, tmp_path: Path, post: str

@@ -360,7 +360,7 @@ class _ToAst(Transformer[Token, Module]):
 
     @_inline
     def dims(self, meta: Meta, args: tuple[Expr | None, ...]) -> tuple[Expr | None, ...]:
-        return args
+        return args or (None,)  # ``name[]``: one extent left open (an array parameter's)
 
     @_inline
     def signal_decl(
