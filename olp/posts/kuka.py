@@ -458,7 +458,9 @@ FILTERS: Mapping[str, Filter] = {
     "krl_event": lambda post, node: krl_event(node),
     "krl_routine_head": lambda post, routine: krl_routine_head(routine),
     "krl_io": lambda post, node, io: krl_io(node, io),
-    "krl_program_head": lambda post, program: krl_program_head(program["name"], program["params"]),
+    "krl_program_head": lambda post, program: krl_program_head(
+        program["name"], program["params"], program["returns"], program["returns_dims"]
+    ),
     "krl_routine_end": lambda post, routine: krl_routine_end(routine),
     "krl_param_decl": lambda post, param: krl_param_decl(param),
     "krl_call": lambda post, call: krl_call(call),
@@ -574,10 +576,16 @@ class KukaPost(Post):
                 if (message, node.span) not in seen:
                     seen.add((message, node.span))
                     found.append(Diagnostic("error", "flow", message, node.span))
-        head = Routine(name=program.name, params=program.params)
-        if program.params and (problem := routine_problem(head)) is not None:
+        head = Routine(
+            name=program.name,
+            params=program.params,
+            returns=program.returns,
+            returns_dims=program.returns_dims,
+        )
+        if (program.params or head.is_function) and (problem := routine_problem(head)):
             message = f"program {program.name} cannot be written in KRL: {problem}"
-            found.append(Diagnostic("error", "flow", message, program.params[0].span))
+            span = program.params[0].span if program.params else None
+            found.append(Diagnostic("error", "flow", message, span))
         for routine in program.routines:
             if (problem := routine_problem(routine)) is not None:
                 message = f"routine {routine.name} cannot be written in KRL: {problem}"

@@ -168,6 +168,7 @@ class Motions(InlineForms):
             "tool": state.tool,
             "frame": state.frame,
             "span": stmt.span,
+            **_spline(stmt.keyword),
         }
         self._emit(make, target, None, fields)
         return True
@@ -615,6 +616,7 @@ class Motions(InlineForms):
             "tool": state.tool,
             "frame": state.frame,
             "span": stmt.span,
+            **_spline(stmt.keyword),
         }
 
     def _note_unread_call(self, span: ir.SourceSpan) -> None:
@@ -896,6 +898,13 @@ class RuntimeStart(str):
 
 
 _MOTION_TEXT = re.compile(r"\s*(S?PTP|S?LIN|S?CIRC)(_REL)?\b", re.IGNORECASE)
+
+
+def _spline(keyword: str) -> dict[str, bool]:
+    """``spline=True`` for a spline motion (``SLIN``, ``SPTP_REL``, ...), so that KRL writes
+    its keyword back; nothing for a plain one (a plain LIN keeps the fields a row of a
+    :class:`~olp.ir.LinearPath` holds, :mod:`olp.frontends.krl.rows`)."""
+    return {"spline": True} if keyword.upper() in _SPLINE_MOTIONS else {}
 
 
 def _is_motion_text(text: str) -> bool:
