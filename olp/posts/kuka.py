@@ -78,6 +78,7 @@ from olp.posts.kuka_flow import (
     krl_return,
     krl_routine_end,
     krl_routine_head,
+    krl_type_definition,
     routine_problem,
 )
 from olp.posts.numbers import NumberFormat, Storage
@@ -455,6 +456,7 @@ FILTERS: Mapping[str, Filter] = {
     "krl_decl": lambda post, step: krl_decl(step),
     "krl_declaration": lambda post, step: krl_declaration(step),
     "krl_declarations": lambda post, steps: krl_declarations(steps),
+    "krl_type_definition": lambda post, step: krl_type_definition(step),
     "krl_event": lambda post, node: krl_event(node),
     "krl_routine_head": lambda post, routine: krl_routine_head(routine),
     "krl_io": lambda post, node, io: krl_io(node, io),

@@ -114,6 +114,21 @@ def krl_declaration(step: Any) -> bool:
     )
 
 
+_TYPE_DEFINITION = re.compile(r"(?i)\s*(GLOBAL\s+)?(STRUC|ENUM)\s")
+
+
+def krl_type_definition(step: Any) -> bool:
+    """Whether ``step`` is a kept KRL type definition of the module's data list (``GLOBAL
+    STRUC MyType INT a, REAL b``, ``ENUM Color red, green``): the templates write it into the
+    ``.dat``, before the declarations that use it, not in the ``.src``'s flow."""
+    node = getattr(step, "instruction", step)
+    return (
+        isinstance(node, ir.Verbatim)
+        and node.language == "krl"
+        and _TYPE_DEFINITION.match(node.text) is not None
+    )
+
+
 def krl_declarations(steps: Any) -> list[str]:
     """The texts of the kept declaration lines among ``steps`` (:func:`krl_declaration`), each
     once (a routine written out at each of its calls brings its EXT lines each time), in

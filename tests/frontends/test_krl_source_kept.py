@@ -180,3 +180,59 @@ def _kinds(program: ir.Program) -> list[str]:
 
 def _is_motion(line: str) -> bool:
     return line.split(" ")[0] in ("PTP", "LIN", "CIRC", "SPTP", "SLIN", "SCIRC")
+
+
+# --------------------------------------------------------------------------------------------
+# The data list's type definitions
+
+TYPED_SRC = """DEF cell( )
+mClamp.nForce = 5
+eSide = #right
+PTP {A1 0, A2 -90, A3 90, A4 0, A5 45, A6 0}
+END
+"""
+
+TYPED_DAT = """DEFDAT cell PUBLIC
+GLOBAL STRUC ClampData INT nForce, REAL rOpen, BOOL bShut
+ENUM SideKind left, right
+DECL GLOBAL ClampData mClamp={nForce 2, rOpen 10.5, bShut FALSE}
+DECL SideKind eSide=#left
+ENDDAT
+"""
+
+
+def test_struc_and_enum_of_the_data_list_are_written_back(station: object, tmp_path: Path) -> None:
+    """A DECL of a STRUC or ENUM type does not compile without its type: the module's own
+    definitions are written into the .dat, before the declarations (they were left out with
+    an info line), and read again the same."""
+    (tmp_path / "cell.dat").write_text(TYPED_DAT)
+    result = _build(station, tmp_path, "cell.src", TYPED_SRC)
+    assert not [d for d in result.diagnostics if d.kind == "ignored"]  # type: ignore[attr-defined]
+    dat = result.files["cell.dat"].splitlines()  # type: ignore[attr-defined]
+    assert dat[3:7] == [
+        "GLOBAL STRUC ClampData INT nForce, REAL rOpen, BOOL bShut",
+        "ENUM SideKind left, right",
+        "DECL GLOBAL CLAMPDATA mClamp={nForce 2, rOpen 10.5, bShut FALSE}",
+        "DECL SIDEKIND eSide=#left",
+    ]
+    assert not [line for line in _src(result) if "STRUC" in line or "ENUM" in line]
+    again = tmp_path / "again"
+    again.mkdir()
+    for name, text in result.files.items():  # type: ignore[attr-defined]
+        (again / name).write_text(text)
+    types = [n.text for n in load_krl(again / "cell.src").program if isinstance(n, ir.Verbatim)]
+    assert types == [
+        "GLOBAL STRUC ClampData INT nForce, REAL rOpen, BOOL bShut",
+        "ENUM SideKind left, right",
+    ]
+
+
+def test_other_posts_leave_type_definitions_out_with_a_warning(
+    station: object, tmp_path: Path
+) -> None:
+    (tmp_path / "cell.dat").write_text(TYPED_DAT)
+    result = _build(station, tmp_path, "cell.src", TYPED_SRC, "abb")
+    warned = [d.span.line for d in result.diagnostics if d.kind == "ignored"]  # type: ignore[attr-defined]
+    assert warned == [2, 3]
+    errors = {d.span.line for d in result.diagnostics if d.severity == "error"}  # type: ignore[attr-defined]
+    assert errors == {2, 3, 4, 5}  # the variables of those types and their uses, as before

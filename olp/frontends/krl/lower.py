@@ -981,8 +981,10 @@ def lower_module(
     ignored = sorted(
         [*lowering.ignored, *assembled.ignored], key=lambda i: (i.span.line, i.span.column)
     )
-    for data_list in (dat, config):
-        ignored.extend(data_list.ignored if data_list is not None else ())
+    written = {span for _, span in dat.types} if dat is not None else set()
+    for data_list in (dat, config):  # the module's own types are written back, not ignored
+        kept = data_list.ignored if data_list is not None else ()
+        ignored.extend(i for i in kept if i.span not in written)
     name = main.name if main is not None else _module_name(src, routines)
     params: tuple[ir.Parameter, ...] = ()
     instructions = list(assembled.instructions)
