@@ -493,12 +493,15 @@ class KukaPost(Post):
             # a whole array or an element (P00(#CHK_HOME, #PGNO_GET, DMY[], 0) in every cell.src;
             # PULSE($OUT[PGNO_REQ], TRUE, 0.2)): names, numbers and commas only inside
             r"\$?" + IDENTIFIER + r"\[[A-Za-z0-9_$,.+\- ]*\]",
+            # a component (SWRITE(..., $DATE.HOUR), lfPos.X, aPts[2].Z): names, dots and an
+            # element's index only
+            r"\$?" + IDENTIFIER + r"(?:\[[A-Za-z0-9_$,.+\- ]*\])?(?:\." + IDENTIFIER + r")+",
             # an aggregate for a STRUC parameter (DrillHole({rX 810, rY 67, rZ 0})), one
             # nested level: KRL takes it as it stands. No ';' (a comment) outside its strings
             AGGREGATE,
         ),
         'numbers, "strings", names, #ENUM values, $ variables, array names and elements '
-        "(NAME[], NAME[1,k]), aggregates ({X 1, Y 2})",
+        "(NAME[], NAME[1,k]), components (NAME.X, $DATE.HOUR), aggregates ({X 1, Y 2})",
     )
     ACCELERATIONS: ClassVar[frozenset[str]] = frozenset(
         {"linear_acceleration", "angular_acceleration"}

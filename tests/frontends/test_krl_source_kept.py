@@ -236,3 +236,40 @@ def test_other_posts_leave_type_definitions_out_with_a_warning(
     assert warned == [2, 3]
     errors = {d.span.line for d in result.diagnostics if d.severity == "error"}  # type: ignore[attr-defined]
     assert errors == {2, 3, 4, 5}  # the variables of those types and their uses, as before
+
+
+# --------------------------------------------------------------------------------------------
+# What a module written as its whole logic needs besides (found in the function modules)
+
+PATH_SRC = """DEF cell(nI:IN)
+DECL INT nI
+DECL CHAR sText[20]
+DECL INT nOffset
+$VEL.CP = 0.2
+PTP {A1 0, A2 -90, A3 90, A4 0, A5 45, A6 0}
+LIN xPath[nI]
+nOffset = 0
+SWRITE(sText[], $DATE.HOUR, nOffset, "%d", $DATE.MINUTE)
+END
+"""
+
+PATH_DAT = """DEFDAT cell PUBLIC
+DECL E6POS xPath[2]
+xPath[1]={X 500, Y 0, Z 400, A 0, B 90, C 0}
+xPath[2]={X 500, Y 50, Z 400, A 0, B 90, C 0}
+ENDDAT
+"""
+
+
+def test_the_data_a_run_time_motion_reads_is_declared_and_components_are_arguments(
+    station: object, tmp_path: Path
+) -> None:
+    """``LIN xPath[nI]``: the written .dat declares xPath (it was left out, so the module did
+    not compile); a call's argument may be a component (``$DATE.HOUR``: it stopped the post
+    with call_argument)."""
+    (tmp_path / "cell.dat").write_text(PATH_DAT)
+    result = _build(station, tmp_path, "cell.src", PATH_SRC)
+    lines = _src(result)
+    assert 'SWRITE(sText[], $DATE.HOUR, nOffset, "%d", $DATE.MINUTE)' in lines
+    dat = result.files["cell.dat"].splitlines()  # type: ignore[attr-defined]
+    assert dat[3:6] == PATH_DAT.splitlines()[1:4]

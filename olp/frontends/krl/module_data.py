@@ -193,6 +193,8 @@ def _expressions(node: Any) -> Iterator[Any]:
         yield from (e for e in (node.start, node.stop, node.step) if e is not None)
     elif isinstance(node, ir.InterruptDecl):
         yield from (node.condition, node.handler)
+    elif isinstance(node, ir.RuntimeMove):  # LIN xPath[i]: the written .dat declares xPath
+        yield from (e for e in (node.via, node.target) if e is not None)
     elif isinstance(node, ir.PathTrigger):
         action = node.action
         yield from (action.target, action.value) if isinstance(action, ir.Assign) else (action,)
