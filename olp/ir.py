@@ -398,11 +398,18 @@ FINE = Zone(0.0)
 
 @dataclass(frozen=True, slots=True, kw_only=True, eq=False)
 class _Motion:
+    """What every motion has. ``spline``: the source asked for the controller's spline
+    motion of this kind (KUKA ``SPTP``/``SLIN``/``SCIRC``, which take their settings from other
+    system variables and approximate differently from ``PTP``/``LIN``/``CIRC``); olp checks and
+    times it as the plain motion, the KUKA post writes the spline keyword back, and the other
+    posts write their plain motion (their languages have no such pair)."""
+
     target: Target
     speed: Speed = field(default_factory=Speed)
     zone: Zone = FINE
     tool: Tool = field(default_factory=lambda: FLANGE)
     frame: Frame = field(default_factory=lambda: WORLD)
+    spline: bool = False
     span: SourceSpan = GENERATED
 
     def with_speed(
@@ -548,6 +555,7 @@ class RuntimeMove:
     a ``$config.dat`` olp was not given); ``speed``, ``zone``, ``tool`` and ``frame`` then mean
     nothing, a post writes none of them (only a post of that statement's language can write
     the motion), and the motion after it writes all of its own.
+    ``spline``: a spline motion of its kind (KUKA ``SLIN``), as for modelled motions.
     ``relative``: None, the target (and via point) is a position; else the target refers to
     the start position, which the robot reaches only at run time (the motion before went to
     a run-time target), as the source language means it: ``"base"`` offsets along and about
@@ -576,6 +584,7 @@ class RuntimeMove:
     reason: str = ""
     controller_settings: bool = False
     relative: Literal["base", "tool", "axes", "start"] | None = None
+    spline: bool = False
     span: SourceSpan = GENERATED
     kind: Literal["runtime_move"] = field(default="runtime_move", init=False)
 
@@ -909,6 +918,19 @@ class Program:
     ``DEF MoveSettings(nBase:IN, nTool:IN)``). Their values are known only when the program
     runs: what its body computes from them is run-time. A post writes them where its language
     lets a program take arguments and refuses the program with a located error otherwise.
+
+    ``returns``: the type name of the program's result where the program is a function that
+    other programs call in an expression (a KRL module whose first routine is ``DEFFCT BOOL
+    RecoverFromWorkSt(...)``), its array extents in ``returns_dims``, as
+    :attr:`Routine.returns`; None for a program without a result. Its body gives the result with
+    :class:`Return` ``(value=...)``. A post writes it where its language has function programs
+    and refuses the program with a located error otherwise.
+
+    ``language``: the robot language the program was read from, as its frontend names it
+    (``"krl"``), None for a program from a neutral format (CSV, the DSL) or built in Python. A
+    post of that language writes what the source said where it would otherwise add text of
+    its own (the KUKA post writes a KRL source's INI fold where it had one and none where it
+    had none; a program from elsewhere gets the template's).
     """
 
     name: str
@@ -916,6 +938,9 @@ class Program:
     source: str = "<memory>"
     routines: tuple[Routine, ...] = ()
     params: tuple[Parameter, ...] = ()
+    returns: str | None = None
+    returns_dims: tuple[_flow.Expr | None, ...] = ()
+    language: str | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.instructions, tuple):
@@ -924,6 +949,12 @@ class Program:
             object.__setattr__(self, "routines", tuple(self.routines))
         if not isinstance(self.params, tuple):
             object.__setattr__(self, "params", tuple(self.params))
+        if not isinstance(self.returns_dims, tuple):
+            object.__setattr__(self, "returns_dims", tuple(self.returns_dims))
+        if self.returns is not None and not self.returns:
+            raise IRError(f"Program {self.name}: returns must be a type name or None")
+        if self.returns_dims and self.returns is None:
+            raise IRError(f"Program {self.name}: returns_dims without a result type (returns)")
         names: set[str] = set()
         for param in self.params:
             if not isinstance(param, Parameter):
@@ -969,9 +1000,10 @@ class Program:
     @property
     def has_flow(self) -> bool:
         """Whether the program holds control flow or data statements (:mod:`olp.ir_flow`),
-        routines and parameters included (a program with parameters is never split into
+        routines, parameters and a result included (such a program is never split into
         parts: a part would not see them)."""
-        return bool(self.routines or self.params) or _flow.has_flow(self.instructions)
+        function = self.returns is not None
+        return bool(self.routines or self.params or function) or _flow.has_flow(self.instructions)
 
     def flat_nodes(self) -> tuple[Instruction | LinearPath, ...]:
         """The nodes in source order with blocks walked into: what the passes check, one step

@@ -551,6 +551,12 @@ class AbbPost(Post):
         "call with arguments would be a PROC with parameters (num p, INOUT num q) and no entry "
         "routine, which olp does not write yet"
     )
+    PROGRAM_RETURNS = (
+        "olp writes a program as the module's entry routine (PROC main, or the post option "
+        "entry), which the controller starts and which gives no result; a module that other "
+        "modules call for a result would be a FUNC (FUNC bool name(...) ... RETURN ...; "
+        "ENDFUNC) and no entry routine, which olp does not write yet"
+    )
     KINDS: ClassVar[frozenset[str]] = Post.KINDS | {"runtime_move"}
     STREAMS = True
     STREAM_NEUTRAL_FILTERS = frozenset({"rapid_pad"})

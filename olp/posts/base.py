@@ -154,6 +154,11 @@ class Post:
     (:attr:`olp.ir.Program.params`), for the located error on a program that has them; None:
     the post writes them (with ``program_params: true`` in its manifest; a folder copied before
     olp wrote them is refused the same way)."""
+    PROGRAM_RETURNS: ClassVar[str | None] = None
+    """Why this language's program cannot give a result (:attr:`olp.ir.Program.returns`: a
+    function program, which other programs call in an expression), for the located error on
+    a program that gives one; None: the post writes it (with ``program_returns: true`` in its
+    manifest; a folder copied before olp wrote it is refused the same way)."""
     VERBATIM: ClassVar[str | None] = None
     """The language of :class:`~olp.ir.Verbatim` statements this post writes unchanged (KUKA:
     ``"krl"``); a verbatim statement of another language is an error on its line."""
@@ -294,6 +299,32 @@ class Post:
         """Whether this post, with its template folder, writes the program's parameters."""
         return self.PROGRAM_PARAMS is None and self.manifest.program_params
 
+    def writes_program_returns(self) -> bool:
+        """Whether this post, with its template folder, writes a function program."""
+        return self.PROGRAM_RETURNS is None and self.manifest.program_returns
+
+    def _returns_error(self, program: Program) -> Diagnostic:
+        from olp.ir_flow import leaves
+
+        why = self.PROGRAM_RETURNS or (
+            f"the template folder {self.manifest.folder} does not say program_returns: true (a "
+            "copy made before olp wrote them would write the program as one without a result)"
+        )
+        message = (
+            f"program {program.name} is a function giving a {program.returns}, which the "
+            f"{self.LANGUAGE} post does not write: {why}"
+        )
+        hint = (
+            "write it as a program without a result for this controller, or build it for KRL"
+            if self.PROGRAM_RETURNS
+            else "update the folder from olp's bundled post and add program_returns: true"
+        )
+        spans = [n.span for n in leaves(program.instructions) if n.kind == "return"]
+        spans += [p.span for p in program.params]
+        return Diagnostic(
+            "error", "program_returns", message, spans[0] if spans else None, hint=hint
+        )
+
     def _params_error(self, program: Program) -> Diagnostic:
         names = ", ".join(p.name for p in program.params)
         why = self.PROGRAM_PARAMS or (
@@ -330,6 +361,8 @@ class Post:
         out = self._foreign_robot(compiled)
         if compiled.program.params and not self.writes_program_params():
             out.append(self._params_error(compiled.program))
+        if compiled.program.returns is not None and not self.writes_program_returns():
+            out.append(self._returns_error(compiled.program))
         if compiled.program.has_flow and not (self.WRITES_FLOW and self.manifest.flow):
             return [*out, self._flow_error(compiled)]
         from olp.compiled import PathBlock, items_of

@@ -616,6 +616,10 @@ class FanucPost(Post):
         "strings, by value), and olp has no Fanuc document at hand to cite for how an LS "
         "program declares and reads them, so it does not write them"
     )
+    PROGRAM_RETURNS = (
+        "a TP program has no result: a CALL runs it for its effects only (values come back "
+        "through registers the program sets, which a caller must be written to read)"
+    )
     ONCE_PER_PROGRAM = frozenset({"controller_frame", "controller_tool"})
     NAME_RULE = NAME_RULE
     COMMENTS = CommentRule(max_length=COMMENT_LENGTH, replace=((";", ","),), collapse=True)

@@ -78,6 +78,7 @@ from olp.posts.kuka_flow import (
     krl_return,
     krl_routine_end,
     krl_routine_head,
+    krl_type_definition,
     routine_problem,
 )
 from olp.posts.numbers import NumberFormat, Storage
@@ -455,10 +456,13 @@ FILTERS: Mapping[str, Filter] = {
     "krl_decl": lambda post, step: krl_decl(step),
     "krl_declaration": lambda post, step: krl_declaration(step),
     "krl_declarations": lambda post, steps: krl_declarations(steps),
+    "krl_type_definition": lambda post, step: krl_type_definition(step),
     "krl_event": lambda post, node: krl_event(node),
     "krl_routine_head": lambda post, routine: krl_routine_head(routine),
     "krl_io": lambda post, node, io: krl_io(node, io),
-    "krl_program_head": lambda post, program: krl_program_head(program["name"], program["params"]),
+    "krl_program_head": lambda post, program: krl_program_head(
+        program["name"], program["params"], program["returns"], program["returns_dims"]
+    ),
     "krl_routine_end": lambda post, routine: krl_routine_end(routine),
     "krl_param_decl": lambda post, param: krl_param_decl(param),
     "krl_call": lambda post, call: krl_call(call),
@@ -489,12 +493,15 @@ class KukaPost(Post):
             # a whole array or an element (P00(#CHK_HOME, #PGNO_GET, DMY[], 0) in every cell.src;
             # PULSE($OUT[PGNO_REQ], TRUE, 0.2)): names, numbers and commas only inside
             r"\$?" + IDENTIFIER + r"\[[A-Za-z0-9_$,.+\- ]*\]",
+            # a component (SWRITE(..., $DATE.HOUR), lfPos.X, aPts[2].Z): names, dots and an
+            # element's index only
+            r"\$?" + IDENTIFIER + r"(?:\[[A-Za-z0-9_$,.+\- ]*\])?(?:\." + IDENTIFIER + r")+",
             # an aggregate for a STRUC parameter (DrillHole({rX 810, rY 67, rZ 0})), one
             # nested level: KRL takes it as it stands. No ';' (a comment) outside its strings
             AGGREGATE,
         ),
         'numbers, "strings", names, #ENUM values, $ variables, array names and elements '
-        "(NAME[], NAME[1,k]), aggregates ({X 1, Y 2})",
+        "(NAME[], NAME[1,k]), components (NAME.X, $DATE.HOUR), aggregates ({X 1, Y 2})",
     )
     ACCELERATIONS: ClassVar[frozenset[str]] = frozenset(
         {"linear_acceleration", "angular_acceleration"}
@@ -574,10 +581,16 @@ class KukaPost(Post):
                 if (message, node.span) not in seen:
                     seen.add((message, node.span))
                     found.append(Diagnostic("error", "flow", message, node.span))
-        head = Routine(name=program.name, params=program.params)
-        if program.params and (problem := routine_problem(head)) is not None:
+        head = Routine(
+            name=program.name,
+            params=program.params,
+            returns=program.returns,
+            returns_dims=program.returns_dims,
+        )
+        if (program.params or head.is_function) and (problem := routine_problem(head)):
             message = f"program {program.name} cannot be written in KRL: {problem}"
-            found.append(Diagnostic("error", "flow", message, program.params[0].span))
+            span = program.params[0].span if program.params else None
+            found.append(Diagnostic("error", "flow", message, span))
         for routine in program.routines:
             if (problem := routine_problem(routine)) is not None:
                 message = f"routine {routine.name} cannot be written in KRL: {problem}"

@@ -114,6 +114,21 @@ def krl_declaration(step: Any) -> bool:
     )
 
 
+_TYPE_DEFINITION = re.compile(r"(?i)\s*(GLOBAL\s+)?(STRUC|ENUM)\s")
+
+
+def krl_type_definition(step: Any) -> bool:
+    """Whether ``step`` is a kept KRL type definition of the module's data list (``GLOBAL
+    STRUC MyType INT a, REAL b``, ``ENUM Color red, green``): the templates write it into the
+    ``.dat``, before the declarations that use it, not in the ``.src``'s flow."""
+    node = getattr(step, "instruction", step)
+    return (
+        isinstance(node, ir.Verbatim)
+        and node.language == "krl"
+        and _TYPE_DEFINITION.match(node.text) is not None
+    )
+
+
 def krl_declarations(steps: Any) -> list[str]:
     """The texts of the kept declaration lines among ``steps`` (:func:`krl_declaration`), each
     once (a routine written out at each of its calls brings its EXT lines each time), in
@@ -156,15 +171,26 @@ def krl_io(node: ir.DigitalInput | ir.SetOutput | ir.WaitInput, io: str) -> str:
     return f"{io}[{node.index}]"
 
 
-def krl_program_head(name: str, params: Sequence[ir.Parameter]) -> str:
+def krl_program_head(
+    name: str,
+    params: Sequence[ir.Parameter],
+    returns: str | None = None,
+    returns_dims: Sequence[ir.Expr | None] = (),
+) -> str:
     """The program's ``DEF``: ``DEF name( )`` as the pendant writes a program without
     parameters, ``DEF name(p:IN, q:OUT)`` for one that other modules call with arguments
     (:attr:`olp.ir.Program.params`, written as a routine's, :func:`krl_routine_head`; their
-    types are declared first in the body, :func:`krl_param_decl`). The module's first DEF is
-    the one other modules call by the module's name, so it needs no ``GLOBAL``."""
-    if not params:
+    types are declared first in the body, :func:`krl_param_decl`), ``DEFFCT BOOL name(...)``
+    for a program that gives a result (:attr:`olp.ir.Program.returns`: a module whose first
+    routine is a function, which other modules call in an expression; it ends with
+    ``ENDFCT``). The module's first routine is the one other modules call by the module's
+    name, so it needs no ``GLOBAL``."""
+    if not params and returns is None:
         return f"DEF {name}( )"
-    return krl_routine_head(ir.Routine(name=name, params=tuple(params)))
+    head = ir.Routine(
+        name=name, params=tuple(params), returns=returns, returns_dims=tuple(returns_dims)
+    )
+    return krl_routine_head(head)
 
 
 def _empty_index(dims: tuple[object, ...]) -> str:

@@ -38,6 +38,10 @@ The manifest says::
                                       # (olp.ir.Program.params; default false: a folder copied
                                       # before would write the program without them, so the
                                       # post refuses a program that has them)
+    program_returns: true             # the templates write a program that gives a result
+                                      # (olp.ir.Program.returns: KRL DEFFCT ... ENDFCT; default
+                                      # false: a folder copied before would write it as one
+                                      # without, so the post refuses such a program)
     runtime_targets: true             # the templates write motions to run-time targets
                                       # (kind runtime_move; default false: a folder copied
                                       # before would leave them out, so the post refuses them)
@@ -87,6 +91,7 @@ class PostManifest:
     module_data: bool = False
     runtime_targets: bool = False
     program_params: bool = False
+    program_returns: bool = False
 
 
 def load_manifest(folder: Path) -> PostManifest:
@@ -112,10 +117,9 @@ def load_manifest(folder: Path) -> PostManifest:
         "routines",
         "runtime_targets",
         "program_params",
+        "program_returns",
     )
-    rows, accelerations, flow, module_data, routines, runtime_targets, program_params = (
-        _flag(raw, key, path) for key in keys
-    )
+    flags = dict(zip(keys, (_flag(raw, key, path) for key in keys), strict=True))
     return PostManifest(
         name=str(raw.get("name", folder.name)),
         vendor=str(raw.get("vendor", "")),
@@ -128,13 +132,7 @@ def load_manifest(folder: Path) -> PostManifest:
         main_files=main_files,
         limits=limits,
         frames_in=frames_in,
-        rows=rows,
-        accelerations=accelerations,
-        flow=flow,
-        module_data=module_data,
-        routines=routines,
-        runtime_targets=runtime_targets,
-        program_params=program_params,
+        **flags,
     )
 
 

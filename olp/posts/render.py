@@ -15,7 +15,11 @@ Template context (every file)
     ``source`` (the program's file name without folders, escaped for a comment), ``main`` (the
     main program's name), ``params`` (the program's own parameters,
     :attr:`olp.ir.Program.params`: a post whose manifest says ``program_params: true`` writes
-    them; empty in a part and in a split program's main).
+    them; empty in a part and in a split program's main), ``returns`` and ``returns_dims`` (the
+    type of the program's result, :attr:`olp.ir.Program.returns`, None for a program without
+    one; None in a part), ``language`` (the robot language the program was read from,
+    :attr:`olp.ir.Program.language`: the KUKA templates write their INI fold only where it is
+    not ``"krl"``, a KRL source's own INI being kept in its statements).
 ``split``
     True when the program was split (in parts and in the main).
 ``unit``
@@ -268,8 +272,20 @@ class _Renderer:
                 lines = self.post.comment_node_lines
                 routines = weave_routines(self.compiled.program, view, lines)
             view = weave(self.compiled.program, view)
-        params = self.compiled.program.params if index == 0 else ()
-        unit = Unit(unit_name or self.name, self.name, self.source, index, count, routine, params)
+        program = self.compiled.program
+        whole = index == 0
+        unit = Unit(
+            unit_name or self.name,
+            self.name,
+            self.source,
+            index,
+            count,
+            routine,
+            program.params if whole else (),
+            program.returns if whole else None,
+            program.returns_dims if whole else (),
+            program.language,
+        )
         return unit_context(
             self.post, self.compiled.station, unit, allocation, view, routines, every
         )
@@ -298,6 +314,12 @@ class Unit:
     params: tuple[Any, ...] = ()
     """The program's own parameters (:attr:`olp.ir.Program.params`; a streamed build has none:
     a program with parameters is never streamed, as it has flow)."""
+    returns: str | None = None
+    """The type of the program's result (:attr:`olp.ir.Program.returns`; never streamed)."""
+    returns_dims: tuple[Any, ...] = ()
+    language: str | None = None
+    """The language the program was read from (:attr:`olp.ir.Program.language`; a streamed
+    build reads CSV, None)."""
 
 
 def unit_context(
@@ -321,6 +343,9 @@ def unit_context(
             "source": unit.source,
             "main": unit.main,
             "params": unit.params,
+            "returns": unit.returns,
+            "returns_dims": unit.returns_dims,
+            "language": unit.language,
         },
         "split": unit.count > 0,
         "unit": {

@@ -68,11 +68,17 @@ def group_rows(
     steps: Sequence[PostStep | RowColumns],
 ) -> list[PostStep | PostRows | RowColumns]:
     """``steps`` with every maximal run of consecutive linear moves as one :class:`PostRows`
-    (a toolpath's :class:`~olp.posts.view.RowColumns` stay as they are)."""
+    (a toolpath's :class:`~olp.posts.view.RowColumns` stay as they are). A spline motion
+    (:attr:`olp.ir.LinearMove.spline`) is not a row: the row writers write the plain one."""
     out: list[PostStep | PostRows | RowColumns] = []
     run: list[PostStep] = []
     for step in steps:
-        if isinstance(step, PostStep) and step.kind == "linear" and step.motion:
+        if (
+            isinstance(step, PostStep)
+            and step.kind == "linear"
+            and step.motion
+            and not getattr(step.instruction, "spline", False)
+        ):
             run.append(step)
             continue
         if run:

@@ -461,6 +461,12 @@ class UrPost(Post):
         "script does not hold (and URScript passes arguments by value only, so an :OUT "
         "parameter has no equivalent)"
     )
+    PROGRAM_RETURNS = (
+        "olp writes a program as one def that the controller runs when it receives the "
+        "script; its result would go to no caller (a URScript def may return a value, but "
+        "only to a caller in the same script, and a module called from other programs has "
+        "no equivalent there)"
+    )
     STREAMS = True
     STREAM_NEUTRAL_FILTERS = frozenset({"ur_pad"})
     TOTAL_KINDS = frozenset({"program_too_long"})

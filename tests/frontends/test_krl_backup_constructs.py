@@ -93,18 +93,29 @@ def test_a_two_dimensional_array_parameter_is_read_and_written_back(
     assert _shape(_read_again(tmp_path, "MatrixTools.src", written)) == _shape(program)
 
 
-def test_a_module_of_functions_only_is_written_without_an_empty_program_of_its_name(
+def test_a_module_of_functions_only_is_its_first_function_and_the_others(
     station: object, tmp_path: Path
 ) -> None:
+    """The module's first routine is the program, a DEFFCT as a DEF (the one other modules
+    call by the module's name), written back as a function without an empty DEF beside it."""
     program, written = _written(station, tmp_path, "SpindleRpm.src", LIBRARY_MODULE)
-    assert [r.name for r in program.routines] == ["SpindleRpm", "Clamp"]
+    assert (program.name, program.returns, [p.name for p in program.params]) == (
+        "SpindleRpm",
+        "REAL",
+        ["rCutSpeed", "rDiameter"],
+    )
+    assert [r.name for r in program.routines] == ["Clamp"]
     heads = [line for line in written.splitlines() if line.startswith(("DEF", "GLOBAL"))]
     assert heads == [
         "DEFFCT REAL SpindleRpm(rCutSpeed:IN, rDiameter:IN)",
         "DEFFCT INT Clamp(nValue:IN)",
     ]
     again = _read_again(tmp_path, "SpindleRpm.src", written)
-    assert [r.name for r in again.routines] == ["SpindleRpm", "Clamp"]
+    assert (again.name, again.returns, [r.name for r in again.routines]) == (
+        "SpindleRpm",
+        "REAL",
+        ["Clamp"],
+    )
     assert _shape(again) == _shape(program)
 
 

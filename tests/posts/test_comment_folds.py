@@ -7,10 +7,12 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import olp
 from olp import ir
+from olp.frontends.csv import CsvOptions
 
 REPO = Path(__file__).resolve().parents[2]
 CELLS = {
@@ -124,11 +126,78 @@ def test_krl_to_krl_writes_the_source_ini_once_and_folds_around_their_motion(
     assert len(warned) == 4 and not [d for d in other.diagnostics if d.severity == "error"]
 
 
-def test_a_program_without_an_ini_fold_gets_the_template_ini(
+TEMPLATE_INI = [
+    ";FOLD INI;%{PE}",
+    "  ;FOLD BASISTECH INI",
+    "    GLOBAL INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )",
+    "    INTERRUPT ON 3",
+    "    BAS (#INITMOV,0 )",
+    "  ;ENDFOLD (BASISTECH INI)",
+    "  ;FOLD USER INI",
+    "    ;Make your modifications here",
+    "",
+    "  ;ENDFOLD (USER INI)",
+    ";ENDFOLD (INI)",
+]
+"""The KUKA post's template INI fold, line for line (posts/kuka/program.src.j2)."""
+
+SETTINGS_MODULE = """DEF ToolChange( )
+; no INI here: another module calls this one with its speeds set
+$VEL.CP = 0.25
+$TOOL = {X 0, Y 0, Z 150, A 0, B 0, C 0}
+$BASE = {X 600, Y 0, Z 200, A 0, B 0, C 0}
+PTP {A1 10,A2 -90,A3 90,A4 0,A5 30,A6 0}
+LIN {X 100, Y 50, Z 120, A 0, B 90, C 0}
+END
+"""
+
+
+def test_a_krl_program_without_an_ini_fold_is_written_without_one(
     stations: dict[str, object], tmp_path: Path
 ) -> None:
-    path = tmp_path / "bare.src"
-    path.write_text("DEF bare( )\n; no INI here\nPTP {A1 10,A2 -90,A3 90,A4 0,A5 30,A6 0}\nEND\n")
+    """A KRL source without an INI fold gets none (issue 15: KRL -> KRL writes what the source
+    had): the template's BAS(#INITMOV) would reset the speeds and accelerations of the module
+    that calls this one. The motions' settings are still written before the first motion that
+    uses them (olp writes them itself): tool, base and axis speeds before the PTP, the path
+    speed before the LIN."""
+    path = tmp_path / "ToolChange.src"
+    path.write_text(SETTINGS_MODULE)
     result = olp.build(stations["kuka"], path, post="kuka")  # type: ignore[arg-type]
-    lines = [line.strip() for line in _lines(result)]
-    assert lines.count(";FOLD INI;%{PE}") == 1 and "; no INI here" in lines
+    assert result.ok, [d.format() for d in result.diagnostics if d.severity == "error"]
+    lines = [line.strip() for line in result.files["ToolChange.src"].splitlines()]
+    assert not [line for line in lines if "INI" in line.upper() and line.startswith(";FOLD")]
+    assert not [line for line in lines if line.startswith(("BAS", "INTERRUPT", "GLOBAL INT"))]
+    ptp = next(k for k, line in enumerate(lines) if line.startswith("PTP"))
+    lin = next(k for k, line in enumerate(lines) if line.startswith("LIN"))
+    before_ptp = [line.split(" =")[0] for line in lines[:ptp] if line.startswith("$")]
+    assert before_ptp == [
+        "$BASE",
+        "$TOOL",
+        *(f"$VEL_AXIS[{i}]" for i in range(1, 7)),
+        *(f"$ACC_AXIS[{i}]" for i in range(1, 7)),
+    ]
+    assert [line for line in lines[ptp:lin] if line.startswith("$")] == ["$VEL.CP = 0.25000"]
+
+
+@pytest.mark.parametrize("source", ["examples/path_xyz.csv", "examples/points_to_program.py"])
+def test_a_program_from_csv_or_python_gets_the_template_ini(
+    stations: dict[str, object], source: str
+) -> None:
+    """Programs that are not KRL have no INI of their own: the post writes its template's,
+    exactly as before."""
+    options = CsvOptions(frame="table", orientation=(180.0, 0.0, 180.0))
+    given = {"program_options": options} if source.endswith(".csv") else {}
+    result = olp.build(stations["kuka"], REPO / source, post="kuka", **given)  # type: ignore[arg-type]
+    (src,) = [text for name, text in result.files.items() if name.endswith(".src")]
+    lines = src.split("\r\n")
+    start = lines.index(";FOLD INI;%{PE}")
+    assert lines[start : start + len(TEMPLATE_INI)] == TEMPLATE_INI
+
+
+def test_a_program_built_in_python_gets_the_template_ini(stations: dict[str, object]) -> None:
+    home = ir.JointMove(target=ir.JointTarget(joints=np.radians([10, -90, 90, 0, 30, 0])))
+    program = ir.Program(name="built", instructions=(home,))
+    result = olp.build(stations["kuka"], program, post="kuka")  # type: ignore[arg-type]
+    lines = result.files["built.src"].split("\r\n")
+    start = lines.index(";FOLD INI;%{PE}")
+    assert lines[start : start + len(TEMPLATE_INI)] == TEMPLATE_INI

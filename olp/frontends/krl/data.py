@@ -86,6 +86,10 @@ class KrlData:
     elements: Mapping[str, tuple[Assign, ...]] = field(default_factory=dict)
     """Name (upper case) -> the assignments of single elements of that array in the list
     (``aCount[2]=5``), in order."""
+    types: tuple[tuple[str, ir.SourceSpan], ...] = ()
+    """The list's type definitions (``GLOBAL STRUC MyType INT a, REAL b``, ``ENUM ...``) as
+    written, with their spans, in order: the module's own are written back to its ``.dat``
+    (:mod:`olp.frontends.krl.module_data`)."""
 
     def names(self) -> tuple[str, ...]:
         """The declared names (upper case), in the order they were read."""
@@ -247,7 +251,10 @@ def _read_block(block: DatBlock, source: Source) -> KrlData:
 
     declarations: dict[str, tuple[Decl, DeclItem]] = {}
     elements: dict[str, tuple[Assign, ...]] = {}
+    types: list[tuple[str, ir.SourceSpan]] = []
     for stmt in block.body:
+        if isinstance(stmt, Other) and stmt.kind in _TYPE_DEFINITIONS:
+            types.append((sources.snippet(stmt.span), stmt.span))
         if isinstance(stmt, Decl):
             names = [item.name.upper() for item in stmt.items]
             declared_at.update((n, item.span) for n, item in zip(names, stmt.items, strict=True))
@@ -279,6 +286,7 @@ def _read_block(block: DatBlock, source: Source) -> KrlData:
         global_names=frozenset(global_names),
         declarations=declarations,
         elements=elements,
+        types=tuple(types),
     )
 
 
@@ -342,7 +350,8 @@ def _read_statement(
     raise _not_data(stmt, sources)
 
 
-_DATA_LIST_OTHERS = frozenset({"EXT", "STRUC", "ENUM"})
+_TYPE_DEFINITIONS = frozenset({"STRUC", "ENUM"})
+_DATA_LIST_OTHERS = frozenset({"EXT", *_TYPE_DEFINITIONS})
 """Statements a data list may hold that olp does not need."""
 
 

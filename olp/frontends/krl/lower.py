@@ -994,20 +994,22 @@ def lower_module(
     shared: Sequence[KrlData] = (),
     calls_keep_settings: tuple[str, ...] = (),
 ) -> KrlResult:
-    """Lower the first DEF of ``module`` and the module's other routines: each called one at
-    every call, kept as a routine where the calls agree (:mod:`olp.frontends.krl.routines`).
-    ``shared``: other modules' data lists whose GLOBAL names the module sees
-    (:func:`~olp.frontends.krl.data.visible_globals`)."""
+    """Lower the program of ``module`` (:func:`_main`) and the module's other routines: each
+    called one at every call, kept as a routine where the calls agree
+    (:mod:`olp.frontends.krl.routines`). ``shared``: other modules' data lists whose GLOBAL
+    names the module sees (:func:`~olp.frontends.krl.data.visible_globals`)."""
     routines = _routines(module, sources, src)
     values = visible_globals(config, shared, dat)
     data = [d for d in (config, *shared, dat) if d is not None]
-    main = next((r for r in routines if r.kind == "DEF"), None)
+    main = _main(routines, src)
     ordered = routines if main is None else [main, *(r for r in routines if r is not main)]
     table = {r.name.upper(): r for r in ordered}
     ctx = Context(sources, table, src, dat, config, MAX_LOWERED_STATEMENTS, shared)
     ctx.calls_keep_settings = calls_keep_settings
     lowering = _Lowering(ctx, State(), _variables(values, ctx, main))
     if main is not None:
+        if main.kind == "DEFFCT":  # its RETURN value gives the result: kept, as a function's
+            lowering.defining = main.name
         lowering.routine = RoutineJumps.of(main.body)
         ctx.called.add(main.name.upper())
         lowering.first_pass(main.body)
@@ -1019,8 +1021,10 @@ def lower_module(
     ignored = sorted(
         [*lowering.ignored, *assembled.ignored], key=lambda i: (i.span.line, i.span.column)
     )
-    for data_list in (dat, config):
-        ignored.extend(data_list.ignored if data_list is not None else ())
+    written = {span for _, span in dat.types} if dat is not None else set()
+    for data_list in (dat, config):  # the module's own types are written back, not ignored
+        kept = data_list.ignored if data_list is not None else ()
+        ignored.extend(i for i in kept if i.span not in written)
     name = main.name if main is not None else _module_name(src, routines)
     params: tuple[ir.Parameter, ...] = ()
     instructions = list(assembled.instructions)
@@ -1032,6 +1036,9 @@ def lower_module(
         source=src,
         routines=assembled.routines,
         params=params,
+        returns=None if main is None else main.returns,
+        returns_dims=() if main is None else _returns_dims(main),
+        language="krl",
     )
     program = with_module_data(program, dat, config, shared)
     return KrlResult(
@@ -1041,6 +1048,20 @@ def lower_module(
         status_turn=tuple(lowering.status_turn),
         data_sources=tuple(d.filename for d in data),
     )
+
+
+def _main(routines: Sequence[Routine], src: str) -> Routine | None:
+    r"""The module's program: its first routine, the one the controller runs (or other modules
+    call) by the module's name, where that is a ``DEF``, or a ``DEFFCT`` named as the file
+    (``DEFFCT BOOL RecoverFromWorkSt(...)`` in ``RecoverFromWorkSt.src``: the module is the
+    function, its logic in it). Else the first ``DEF`` (text given without a file name); a
+    module of functions none of which is named as the file (a library of ``GLOBAL DEFFCT``\ s
+    called from other modules) has none: an empty program holding them as routines."""
+    first = routines[0]
+    stem = os.path.splitext(os.path.basename(src))[0]
+    if first.kind == "DEF" or first.name.upper() == stem.upper():
+        return first
+    return next((r for r in routines if r.kind == "DEF"), None)
 
 
 def _variables(values: Any, ctx: Context, main: Routine | None) -> Variables:
@@ -1055,6 +1076,13 @@ def _variables(values: Any, ctx: Context, main: Routine | None) -> Variables:
         }
     )
     return variables
+
+
+def _returns_dims(main: Routine) -> tuple[ir.Expr | None, ...]:
+    """The array extents of a function program's result (``DEFFCT CHAR[128] Text( )``)."""
+    from olp.frontends.krl.flow import to_expr
+
+    return tuple(to_expr(d, lambda _: None) for d in main.returns_dims)
 
 
 def _lower_alone(

@@ -12,6 +12,14 @@ program: ``scope="module"`` for the module's own ``.dat`` (with its value, and t
 elements the list sets one by one), ``scope="external"`` for a name of another data list or
 ``$config.dat`` (a post for a KUKA controller refers to it; another vendor's cannot). Points
 used only as motion targets are not declared: their values are in the motions.
+
+The module's own type definitions (``GLOBAL STRUC MyType INT a, REAL b``, ``ENUM Color red,
+green``) come first, each a native-only :class:`olp.ir.Verbatim` (:func:`type_definitions`):
+the KRL post writes them back into the ``.dat`` before the declarations that use them (a
+``DECL MyType`` without its ``STRUC`` does not compile). Other posts leave them out with a
+warning: RAPID could map a STRUC to a RECORD, but every variable or component of such a type
+is already refused where the program uses it (no counterpart olp writes), so a type alone has
+nothing to serve there; a program that uses none builds without it.
 """
 
 from __future__ import annotations
@@ -39,6 +47,7 @@ def with_module_data(
 ) -> ir.Program:
     """``program`` with a declaration of every data-list variable its statements use first
     (those of its routines too, but for a routine's own parameters and locals)."""
+    program = _with_types(program, dat)
     routines = program.routines
     used, in_text = _used_names([*program.instructions, *(n for r in routines for n in r.body)])
     local = {p.name.upper() for r in routines for p in r.params}
@@ -64,6 +73,29 @@ def with_module_data(
     if not added:
         return program
     return dataclasses.replace(program, instructions=(*added, *program.instructions))
+
+
+TYPE_REASON = (
+    "a KRL type definition of the module's data list: only a KRL controller reads it (a "
+    "variable of this type is refused where the program uses it)"
+)
+
+
+def type_definitions(dat: KrlData | None) -> tuple[ir.Verbatim, ...]:
+    """The module's own STRUC/ENUM definitions as native-only KRL lines (module text)."""
+    if dat is None:
+        return ()
+    return tuple(
+        ir.Verbatim(text=text, language="krl", reason=TYPE_REASON, native_only=True, span=span)
+        for text, span in dat.types
+    )
+
+
+def _with_types(program: ir.Program, dat: KrlData | None) -> ir.Program:
+    types = type_definitions(dat)
+    if not types:
+        return program
+    return dataclasses.replace(program, instructions=(*types, *program.instructions))
 
 
 def _globals(config: KrlData | None, shared: Sequence[KrlData]) -> list[KrlData]:
@@ -161,6 +193,8 @@ def _expressions(node: Any) -> Iterator[Any]:
         yield from (e for e in (node.start, node.stop, node.step) if e is not None)
     elif isinstance(node, ir.InterruptDecl):
         yield from (node.condition, node.handler)
+    elif isinstance(node, ir.RuntimeMove):  # LIN xPath[i]: the written .dat declares xPath
+        yield from (e for e in (node.via, node.target) if e is not None)
     elif isinstance(node, ir.PathTrigger):
         action = node.action
         yield from (action.target, action.value) if isinstance(action, ir.Assign) else (action,)

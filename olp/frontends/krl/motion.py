@@ -181,6 +181,7 @@ class Motions(InlineForms):
             "tool": state.tool,
             "frame": state.frame,
             "span": stmt.span,
+            **_spline(stmt.keyword),
         }
         self._emit(make, target, None, fields)
         return True
@@ -411,6 +412,7 @@ class Motions(InlineForms):
                 via=self._target_expr(stmt.targets[0]) if base == "CIRC" else None,
                 reason=why if runtime is None else f"{runtime}; {why}",
                 controller_settings=True,
+                spline=stmt.keyword.upper() in _SPLINE_MOTIONS,
                 relative=relative,
                 span=stmt.span,
             )
@@ -639,6 +641,7 @@ class Motions(InlineForms):
             "tool": state.tool,
             "frame": state.frame,
             "span": stmt.span,
+            **_spline(stmt.keyword),
         }
 
     def _note_default_speed(self, stmt: MotionStmt) -> None:
@@ -905,6 +908,13 @@ class RuntimeStart(str):
 
 
 _MOTION_TEXT = re.compile(r"\s*(S?PTP|S?LIN|S?CIRC)(_REL)?\b", re.IGNORECASE)
+
+
+def _spline(keyword: str) -> dict[str, bool]:
+    """``spline=True`` for a spline motion (``SLIN``, ``SPTP_REL``, ...), so that KRL writes
+    its keyword back; nothing for a plain one (a plain LIN keeps the fields a row of a
+    :class:`~olp.ir.LinearPath` holds, :mod:`olp.frontends.krl.rows`)."""
+    return {"spline": True} if keyword.upper() in _SPLINE_MOTIONS else {}
 
 
 def _is_motion_text(text: str) -> bool:
