@@ -1,0 +1,92 @@
+"""Valid KRL that real KR C4 backups hold and olp stopped on (issue 15): each test is a small
+program of olp's own in the style of the real file, read the way the controller means it."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from olp import ir
+from olp.frontends.krl import KrlData, KrlResult, load_config_dat, parse_krl
+from olp.ir_flow import leaves_and_blocks
+
+REPO = Path(__file__).resolve().parents[2]
+CONFIG = REPO / "examples" / "robot_config.dat"
+HOME = "PTP {A1 0,A2 -90,A3 90,A4 0,A5 30,A6 0}"
+SETUP = ("$TOOL = TOOL_DATA[1]", "$BASE = BASE_DATA[1]", "$VEL.CP = 0.2", HOME)
+
+
+@pytest.fixture(scope="module")
+def config() -> KrlData:
+    return load_config_dat(CONFIG)
+
+
+def parse(config: KrlData, *body: str) -> KrlResult:
+    return parse_krl("\n".join(["DEF t( )", *body, "END", ""]), "t.src", config=config)
+
+
+def runtime(result: KrlResult) -> list[ir.RuntimeMove]:
+    nodes = leaves_and_blocks(result.program.instructions)
+    return [n for n in nodes if isinstance(n, ir.RuntimeMove)]
+
+
+def test_a_variable_one_case_of_a_loop_sets_is_a_run_time_value_in_another(
+    config: KrlData,
+) -> None:
+    """``LOOP SWITCH ... CASE 1 LIN seam ... DEFAULT seam = {...}``: a pass may read the value an
+    earlier pass left, so the motion is a run-time motion, not "declared without a value" (the
+    controller stops only on a first pass that reads it before any pass assigned it: said)."""
+    result = parse(
+        config,
+        "DECL POS seam",
+        *SETUP,
+        "LOOP",
+        "  SWITCH $IN[5]",
+        "  CASE TRUE",
+        "    LIN seam",
+        "  DEFAULT",
+        "    seam = {X 500,Y 0,Z 400,A 0,B 90,C 0}",
+        "  ENDSWITCH",
+        "ENDLOOP",
+    )
+    (move,) = runtime(result)
+    assert move.span.line == 10
+    assert "gets one in its body (line 12)" in move.reason
+    assert "a first pass that reads it before assigning it stops the controller" in move.reason
+
+
+def test_a_member_assigned_of_a_point_array_declared_in_a_missing_file_stays_run_time(
+    config: KrlData,
+) -> None:
+    """``pts[i].A = -30`` then ``LIN pts[i]`` where ``pts`` is declared in a data list olp was
+    not given: the other components are that file's, so the target is the run's (before: a
+    point of A alone, "leaves out X, Y, Z"), and the loop stays one loop (unrolling it would
+    only repeat run-time motions)."""
+    result = parse(
+        config,
+        "INT i",
+        *SETUP,
+        "FOR i = 1 TO 30000",
+        "  gPts[i].A = -30",
+        "  LIN gPts[i] C_DIS",
+        "ENDFOR",
+    )
+    (loop,) = [n for n in result.program.instructions if isinstance(n, ir.For)]
+    assert not [n for n in result.program.instructions if isinstance(n, ir.LinearMove)]
+    (move,) = runtime(result)
+    assert move in loop.body
+    assert move.target.base.name == "gPts"  # type: ignore[union-attr]
+    assigns = [n for n in loop.body if isinstance(n, ir.Assign)]
+    assert [a.span.line for a in assigns] == [8]
+
+
+def test_a_member_assigned_of_a_point_declared_in_a_missing_file_stays_run_time(
+    config: KrlData,
+) -> None:
+    """Straight-line ``gSeam.Z = 80`` then ``LIN gSeam``: the other components are those of the
+    data list olp was not given, and the reason says so."""
+    result = parse(config, *SETUP, "gSeam.Z = 80", "LIN gSeam")
+    (move,) = runtime(result)
+    assert "GSEAM is not declared in t.src" in move.reason
+    assert "olp takes it as a value known only when the program runs" in move.reason
