@@ -8,6 +8,7 @@ from pathlib import Path
 import pytest
 
 from olp import ir
+from olp.errors import ParseError
 from olp.frontends.krl import KrlData, KrlResult, load_config_dat, parse_krl
 from olp.ir_flow import leaves_and_blocks
 
@@ -90,3 +91,71 @@ def test_a_member_assigned_of_a_point_declared_in_a_missing_file_stays_run_time(
     (move,) = runtime(result)
     assert "GSEAM is not declared in t.src" in move.reason
     assert "olp takes it as a value known only when the program runs" in move.reason
+
+
+def test_a_ptp_rel_by_a_run_time_axis_value_is_a_run_time_relative_motion(
+    config: KrlData,
+) -> None:
+    """``PTP_REL joint`` where ``joint`` (``DECL AXIS``) comes from the run, as the first motion
+    of its CASE: a run-time motion by offsets of the axes (its declared type says so), with
+    the settings in effect written before it (before: kept as written only right after a
+    PTP of the same block, else an error)."""
+    result = parse(
+        config,
+        "DECL AXIS joint",
+        "DECL INT cmd",
+        *SETUP,
+        "joint = $AXIS_ACT_MEAS",
+        "SWITCH cmd",
+        "CASE 4",
+        "  PTP_REL joint",
+        "ENDSWITCH",
+    )
+    (move,) = runtime(result)
+    assert (move.span.line, move.motion, move.relative) == (11, "joint", "axes")
+    assert move.tool.number == 1 and move.frame.number == 1
+
+
+@pytest.mark.parametrize(
+    ("head", "tail"),
+    [
+        ("DEF probe( )", "DEF arm( )\nINTERRUPT DECL 5 WHEN $IN[3] DO probe( )\nEND"),
+        ("DEF probe(n:IN)\nINT n", ""),
+    ],
+    ids=["interrupt-handler", "parameters"],
+)
+def test_a_rel_motion_first_in_a_routine_started_elsewhere_is_run_time(
+    config: KrlData, head: str, tail: str
+) -> None:
+    """``LIN_REL {X -10} #TOOL`` as the first motion of an interrupt handler, or of a routine a
+    caller in another module runs (it takes parameters): it starts where the robot was
+    stopped or left, known only when the program runs, so it is a run-time motion by a tool
+    offset (before: "olp cannot know it because there is no earlier Cartesian target")."""
+    body = "\n".join([*SETUP[:3], "LIN_REL {X -10} #TOOL", "LIN_REL {X 10} #TOOL"])
+    text = f"{head}\n{body}\nEND\n{tail}\n"
+    result = parse_krl(text, "t.src", config=config)
+    moves = runtime(result)
+    assert [(m.motion, m.relative) for m in moves] == [("linear", "tool")] * 2
+    assert "starts where" in moves[0].reason
+
+
+def test_a_program_selected_on_its_own_still_needs_a_known_start(config: KrlData) -> None:
+    """The same motion first in a program without parameters that no interrupt runs: the
+    controller's first motion (its BCO run) must not depend on where the robot stands."""
+    with pytest.raises(ParseError, match="olp cannot know it because"):
+        parse(config, *SETUP[:3], "LIN_REL {X -10} #TOOL")
+
+
+def test_a_lin_rel_by_an_offset_declared_in_a_missing_file_is_a_run_time_motion(
+    config: KrlData,
+) -> None:
+    """``LIN_REL gOffset`` after a call of another module's routine, ``gOffset`` declared in a
+    data list olp was not given: a run-time motion by a base offset, its settings written
+    before it as before any motion (before: an error, since no LIN of the same block before
+    it had written them)."""
+    result = parse(
+        config, *SETUP, "LIN {X 500,Y 0,Z 400,A 0,B 90,C 0}", "Measure(xEnd)", "LIN_REL gOffset"
+    )
+    (move,) = runtime(result)
+    assert (move.span.line, move.motion, move.relative) == (8, "linear", "base")
+    assert "GOFFSET is not declared in t.src" in move.reason

@@ -62,7 +62,7 @@ from olp.frontends.krl.flow import (
     to_expr,
 )
 from olp.frontends.krl.module_data import with_module_data
-from olp.frontends.krl.motion import Motions
+from olp.frontends.krl.motion import Motions, RuntimeStart
 from olp.frontends.krl.native import INI_TITLE, native_reason
 from olp.frontends.krl.routines import PendingCall, assemble, moves, typed_params
 from olp.frontends.krl.rows import build_instructions
@@ -372,6 +372,7 @@ class _Lowering(Motions, Events):
         (:class:`olp.ir.Declare`, one per name)."""
         self.data.declare(stmt, self.variables.declare, local=True)
         for item in stmt.items:
+            self.ctx.declared_types[item.name.upper()] = stmt.type_name.upper()
             dims = tuple(to_expr(d, self._input_of) for d in item.dims or ())
             value = None if item.value is None else self._expr(item.value)
             self.out.append(
@@ -1008,6 +1009,9 @@ def lower_module(
     if main is not None:
         lowering.routine = RoutineJumps.of(main.body)
         ctx.called.add(main.name.upper())
+        started = _started_elsewhere(main, routines)
+        if started is not None:
+            lowering.track.lose(RuntimeStart(started))
         lowering.first_pass(main.body)
         lowering.lower_body(main.body)
         lowering.report_unwritten_settings()
@@ -1039,6 +1043,27 @@ def lower_module(
         status_turn=tuple(lowering.status_turn),
         data_sources=tuple(d.filename for d in data),
     )
+
+
+def _started_elsewhere(main: Routine, routines: Sequence[Routine]) -> str | None:
+    """Why the robot's position when ``main`` starts is known only when the program runs, else
+    None: it takes parameters (a caller in another module gives them, from wherever that left
+    the robot), or an ``INTERRUPT DECL`` of the module runs it (from wherever the interrupt
+    stops the robot). A motion that refers to its start (``LIN_REL {X -10} #TOOL`` first)
+    is then a run-time motion. A program without either starts where the robot stands when
+    it is selected, which the controller's first motion (its BCO run) must not depend on:
+    such a motion stays an error."""
+    if main.params:
+        return f"{main.name} takes parameters: it starts where its caller left the robot"
+    for routine in routines:
+        for stmt in statements(routine.body):
+            action = stmt.action if isinstance(stmt, InterruptDecl) else None
+            if isinstance(action, CallStmt) and action.name.upper() == main.name.upper():
+                return (
+                    f"{main.name} runs from the INTERRUPT DECL at line {stmt.span.line}: it "
+                    "starts where the interrupt stops the robot"
+                )
+    return None
 
 
 def _variables(values: Any, ctx: Context, main: Routine | None) -> Variables:
