@@ -159,3 +159,44 @@ def test_a_lin_rel_by_an_offset_declared_in_a_missing_file_is_a_run_time_motion(
     (move,) = runtime(result)
     assert (move.span.line, move.motion, move.relative) == (8, "linear", "base")
     assert "GOFFSET is not declared in t.src" in move.reason
+
+
+STATIONARY_DAT = """DEFDAT nut PUBLIC
+DECL E6POS XP1={X 500,Y 0,Z 400,A 0,B 90,C 0,E1 0,E2 0,E3 0,E4 0,E5 0,E6 0}
+DECL E6POS XP2={X 520,Y 0,Z 400,A 0,B 90,C 0,E1 0,E2 0,E3 0,E4 0,E5 0,E6 0}
+DECL FDAT FP1={TOOL_NO 1,BASE_NO 1,IPO_FRAME #TCP,POINT2[] " ",TQ_STATE FALSE}
+DECL FDAT FP2={TOOL_NO 1,BASE_NO 1,IPO_FRAME #BASE,POINT2[] " ",TQ_STATE FALSE}
+DECL PDAT PPDAT1={VEL 100,ACC 100,APO_DIST 100}
+DECL LDAT LCPDAT1={VEL 2,ACC 100,APO_DIST 100,APO_FAC 50.0,ORI_TYP #VAR,CIRC_TYP #BASE}
+ENDDAT
+"""
+STATIONARY_SRC = """DEF nut( )
+PDAT_ACT=PPDAT1
+FDAT_ACT=FP1
+BAS(#PTP_PARAMS,100)
+PTP XP1
+LDAT_ACT=LCPDAT1
+FDAT_ACT=FP2
+BAS(#CP_PARAMS,2)
+LIN XP2
+END
+"""
+
+
+def test_a_motion_with_a_stationary_tool_is_a_run_time_motion(config: KrlData) -> None:
+    """An inline form whose FDAT says ``IPO_FRAME #TCP`` (an external TCP: the tool stands in
+    the cell, the robot carries the part): olp models robot-held tools only, so its BAS is
+    kept as written and the PTP after it is a run-time motion with the controller's settings
+    (not checked; the reason names the FDAT), while the next form, ``#BASE``, is lowered as
+    any (before: the data list stopped the build)."""
+    from olp.frontends.krl import parse_dat
+
+    dat = parse_dat(STATIONARY_DAT, "nut.dat")
+    result = parse_krl(STATIONARY_SRC, "nut.src", dat=dat, config=config)
+    kept = [n for n in result.program.instructions if isinstance(n, ir.Verbatim)]
+    assert [n.text for n in kept] == ["BAS(#PTP_PARAMS,100)"]
+    assert "IPO_FRAME #TCP (nut.dat:4" in kept[0].reason
+    (ptp,) = runtime(result)
+    assert ptp.controller_settings and ptp.span.line == 5
+    (lin,) = [n for n in result.program.instructions if isinstance(n, ir.LinearMove)]
+    assert lin.span.line == 9
