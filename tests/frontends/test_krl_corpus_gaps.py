@@ -200,3 +200,27 @@ def test_a_motion_with_a_stationary_tool_is_a_run_time_motion(config: KrlData) -
     assert ptp.controller_settings and ptp.span.line == 5
     (lin,) = [n for n in result.program.instructions if isinstance(n, ir.LinearMove)]
     assert lin.span.line == 9
+
+
+def test_a_rel_motion_after_a_loop_over_run_time_targets_is_a_run_time_motion(
+    config: KrlData,
+) -> None:
+    """``FOR i = 0 TO 5 / LIN fnCirc(i) / ENDFOR`` stays one loop (its targets are the run's
+    whatever ``i``); the ``LIN_REL`` after it starts where a pass of it, or the motion before
+    it, left the robot: one of them known only when the program runs, so it is a run-time
+    motion (as when the loop was unrolled and its last pass ended the program text's
+    knowledge)."""
+    result = parse(
+        config,
+        "INT i",
+        *SETUP,
+        "LIN {X 500,Y 0,Z 400,A 0,B 90,C 0}",
+        "FOR i = 0 TO 5",
+        "  LIN fnCirc(i)",
+        "ENDFOR",
+        "LIN_REL {Z 100}",
+    )
+    (loop,) = [n for n in result.program.instructions if isinstance(n, ir.For)]
+    circ, rel = runtime(result)
+    assert circ in loop.body and (rel.span.line, rel.relative) == (11, "base")
+    assert "one known only when the program runs" in rel.reason

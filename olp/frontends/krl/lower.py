@@ -834,6 +834,12 @@ class _Lowering(Motions, Events):
         if any(t != tracks[0] for t in tracks[1:]):
             self.track = dataclasses.replace(tracks[0])
             reason = f"the paths through {where} end at different positions"
+            if any(
+                t.cartesian is None and isinstance(t.no_cartesian, RuntimeStart) for t in tracks
+            ):
+                # one path ends where only the run knows: so does the join (a motion that
+                # refers to its start is a run-time motion, as after that path alone)
+                reason = RuntimeStart(f"{reason}, one known only when the program runs")
             self.track.lose_cartesian(reason)
             self.track.joints, self.track.no_joints = None, reason
         else:
