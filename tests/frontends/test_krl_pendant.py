@@ -626,7 +626,7 @@ def test_signals_from_config(config: KrlData) -> None:
         (["SPLINE", f"  SPL {FULL}", "ENDSPLINE"], 2, 1, "SPLINE ... ENDSPLINE blocks (lines 2-4)"),
         ([f"SPTP {FULL} C_VEL"], 2, 1, "C_SPL"),
         ([f"LIN {FULL} #TOOL"], 2, len(f"LIN {FULL} #"), "only the _REL motions"),
-        (["FDAT_ACT = {TOOL_NO 1,IPO_FRAME #TCP}", "BAS(#FRAMES)"], 2, 33, "#TCP"),
+        (["$IPO_MODE = #TCP"], 2, 13, "#TCP"),
         (["BAS(#PTP_PARAMS, 100)"], 2, 1, "FDAT_ACT"),
     ],
 )

@@ -92,13 +92,17 @@ def test_xhome_without_config_dat_names_the_missing_file_and_is_not_guessed() ->
     np.testing.assert_allclose(first.target.joints, np.radians([0, -90, 90, 0, 30, 0]))
 
 
-def test_a_rel_motion_by_run_time_offsets_stays_as_written(config: KrlData) -> None:
-    """A _REL motion is relative to where the robot is: RuntimeMove holds absolute targets,
-    so LIN_REL by run-time offsets is kept as written, as before."""
+def test_a_rel_motion_by_run_time_offsets_is_a_run_time_relative_motion(
+    config: KrlData,
+) -> None:
+    """A _REL motion by run-time offsets is a run-time motion whose target refers to its start
+    (``relative``: a base offset here), written back as ``LIN_REL pOff`` by the KRL post
+    (before RuntimeMove had ``relative`` it was kept as written)."""
     body = ("DECL E6POS pOff", *SETUP, "LIN {X 500,Y 0,Z 400,A 0,B 90,C 0}", "pOff = $POS_ACT")
     result = lower(*body, "LIN_REL pOff", config=config)
-    kept = [n for n in result.program if isinstance(n, ir.Verbatim)]
-    assert [n.text for n in kept] == ["LIN_REL pOff"] and runtime(result) == []
+    assert not [n for n in result.program if isinstance(n, ir.Verbatim)]
+    (move,) = runtime(result)
+    assert (move.motion, move.relative) == ("linear", "base")
 
 
 def test_the_motions_after_a_run_time_bas_run_with_the_controller_settings(

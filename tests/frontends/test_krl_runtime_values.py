@@ -235,11 +235,12 @@ def test_held_measured_axes_are_no_motion(config: KrlData) -> None:
     assert ptp.span.line == 7 and "no motion" in ptp.reason
 
 
-def test_a_constant_for_loop_over_run_time_positions_is_kept_once_per_pass(
+def test_a_constant_for_loop_over_run_time_positions_stays_one_loop(
     config: KrlData,
 ) -> None:
-    """A constant FOR loop is still unrolled when its body holds a run-time target: the PTP
-    is a run-time motion once per pass."""
+    """A constant FOR loop whose body holds a target that is the run's whatever the counter
+    stays one loop (unrolling it would only repeat the run-time motion, 30,000 times in a
+    real milling cell's program): the PTP is a run-time motion in the FOR's body."""
     result = parse(
         config,
         "DECL E6POS p",
@@ -254,7 +255,9 @@ def test_a_constant_for_loop_over_run_time_positions_is_kept_once_per_pass(
         HOME,
     )
     ptps = runtime(result)
-    assert [(n.span.line, n.motion) for n in ptps] == [(10, "joint"), (10, "joint")]
+    assert [(n.span.line, n.motion) for n in ptps] == [(10, "joint")]
+    (loop,) = [n for n in result.program.instructions if isinstance(n, ir.For)]
+    assert ptps[0] in loop.body
     assert [m.span.line for m in result.program.motions()] == [6, 12]
 
 

@@ -53,12 +53,15 @@ What is lowered
   tool, base, speed and approximation are those in effect (the posts write them before it as
   before any motion), and ``reason`` says why olp cannot know the target. The passes warn that
   they cannot check or time it, and the next motion starts where olp does not know. A
-  ``_REL`` motion by run-time offsets is kept as written
-  (:class:`olp.ir.Verbatim`), and only right after a modelled motion of its kind with the same
-  settings, in the same straight stretch (elsewhere an error saying why). A motion whose
-  target refers to its start position (``LIN_REL {Z 50}``, ``PTP_REL {A6 15}``, ``LIN {Z
-  500}``) right where a run-time motion left the robot is a run-time motion too, its target
-  the expression and ``relative`` saying how it refers to the start (only KRL writes it).
+  ``_REL`` motion by run-time offsets is a run-time motion with ``relative`` saying how its
+  target refers to the start (a ``PTP_REL`` by a variable: by the type its ``DECL`` gives,
+  axes or position; of an undeclared type it is kept as written, :class:`olp.ir.Verbatim`,
+  only right after a modelled PTP with the same settings in the same straight stretch). A
+  motion whose target refers to its start position (``LIN_REL {Z 50}``, ``PTP_REL {A6 15}``,
+  ``LIN {Z 500}``) right where a run-time motion left the robot, or first in a program that
+  takes parameters or that an ``INTERRUPT DECL`` of the module runs (it starts where its
+  caller, or the interrupt, left the robot), is a run-time motion too, its target the
+  expression and ``relative`` saying how it refers to the start (only KRL writes it).
 * **Names no file olp read declares.** Where a file the controller would find a name in was
   not given (the module's ``.dat`` is not beside the ``.src``, or no ``$config.dat``), such a
   name is a value known only when the program runs, never guessed: a warning per name at its
@@ -100,7 +103,9 @@ What is lowered
   ``LDAT_ACT=...``/``FDAT_ACT=FP1`` (assignments), ``BAS(#PTP_PARAMS, v)`` (FDAT_ACT's TOOL_NO,
   BASE_NO, IPO_FRAME; joint speed ``v`` %, PDAT_ACT's ACC % and APO_DIST mm), ``BAS(#CP_PARAMS, v)``
   (frames; ``$VEL.CP = v`` m/s, LDAT_ACT's APO_DIST mm), ``$H_POS=XHOME`` (also kept as written: the
-  controller's home for its ``$IN_HOME`` output), the motion.
+  controller's home for its ``$IN_HOME`` output), the motion. An FDAT with ``IPO_FRAME #TCP``
+  (a stationary tool, the robot carrying the part) is not modelled: its BAS is kept as written
+  and the motion after it is a run-time motion with the controller's settings (not checked).
   ``BAS(#FRAMES|#PTP_DAT|#CP_DAT|#VEL_CP|#VEL_PTP|#ACC_PTP|#TOOL|#BASE, ...)`` likewise. The spline
   inline forms' ``WITH $VEL_AXIS[1] = SVEL_JOINT(100.0), $TOOL = STOOL2(FP1), $BASE =
   SBASE(FP1.BASE_NO), $APO = SAPO_PTP(PPDAT1), ...`` are read, for that motion only. This follows
@@ -131,9 +136,11 @@ What is lowered
   motion setting (speed, zone, tool, base) that differs between the paths is an error at the
   next motion that relies on it (the inline forms set them again, so pendant programs pass). A
   loop's body starts from the join of the state before it and after a pass (variables it
-  assigns are unknown inside). ``FOR`` loops with constant integer bounds over straight-line
-  code are unrolled (at most :data:`~olp.frontends.krl.lower.MAX_FOR_ITERATIONS` iterations,
-  and :data:`~olp.frontends.krl.lower.MAX_LOWERED_STATEMENTS` statements in all); others are a
+  assigns are unknown inside; one without a value before the loop holds, from the run, what
+  an earlier pass left: ``LOOP SWITCH cmd CASE 1 LIN p ... CASE 2 p = ...``). ``FOR`` loops
+  with constant integer bounds over straight-line code are unrolled where a target depends on
+  the counter (at most :data:`~olp.frontends.krl.lower.MAX_FOR_ITERATIONS` iterations, and
+  :data:`~olp.frontends.krl.lower.MAX_LOWERED_STATEMENTS` statements in all); others are a
   :class:`~olp.ir.For` block; a statement after an unrolled loop that reads its counter is an
   error (the value KRL leaves in it is not written: :class:`olp.frontends.krl.flow.PastFor`).
   A jump back to a label makes the variables the routine assigns
@@ -159,7 +166,7 @@ Nothing is dropped silently: every statement olp recognised but did not lower is
 the program's own as warnings). Statements that matter to the controller but that olp does not
 model (motion parameters such as ``$ACC.CP``, ``$VEL.ORI1``, ``$ADVANCE``; ``SET_CD_PARAMS``,
 ``PULSE``, ``HALT``, ``BRAKE``, ``CONTINUE``, ``ON_ERROR_PROCEED``, ``RESUME``, motions to
-``$POS_ACT``, ``_REL`` motions by run-time offsets) are kept in the program as
+``$POS_ACT``, ``PTP_REL`` by run-time offsets of an unknown type) are kept in the program as
 :class:`olp.ir.Verbatim`: the KRL post writes them
 back, other posts stop on them. ``$ORI_TYPE``/``$CIRC_TYPE`` are motion settings (the arcs'
 orientation rule); for linear moves olp notes at each one that it does not model them.

@@ -149,6 +149,13 @@ class DataOps:
         """``name[...].field = value`` with a constant value; else the variable becomes unknown."""
         target = stmt.target
         name = target.name.upper()
+        if target.selectors and not self.variables.is_declared(name):
+            elsewhere = self.variables.lookup(name)
+            if isinstance(elsewhere, Unknown) and not elsewhere.missing:
+                # A part of a record or array declared in a file olp was not given: the parts
+                # the program does not assign are that file's, known only when it runs.
+                self._forget(name, stmt, elsewhere)
+                return f"the rest of {target.name} is not known: {elsewhere.reason}"
         value = self.evaluator.evaluate(stmt.value)
         keys = self._keys(target)
         for unknown in (value, keys):

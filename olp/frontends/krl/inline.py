@@ -10,6 +10,7 @@ controller). See :mod:`olp.frontends.krl` for the rules.
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import Any
 
 from olp.frontends.krl.ast import (
     Aggregate,
@@ -97,7 +98,30 @@ class InlineForms(Core):
             if value is not None and self._runtime(value):
                 assert isinstance(value, Unknown)
                 return value.reason
+            stationary = self._stationary_tool(value) if read == "FDAT_ACT" else None
+            if stationary is not None:
+                return stationary
         return None
+
+    def _stationary_tool(self, fdat: Any) -> str | None:
+        """Why an FDAT's ``IPO_FRAME #TCP`` leaves the motions it sets to the run, else None.
+
+        ``#TCP`` is KUKA's external-TCP mode: the tool stands in the cell (a nut welder, a
+        pedestal gun) and the robot carries the part past it, so the programmed point is the
+        part's, in the fixed tool's frame. olp models robot-held tools only: the BAS is kept as
+        written and the motion right after it runs with the settings it gives (a run-time
+        motion: written back as written by the KUKA post, not checked, refused by the others).
+        """
+        mode = fdat.member("IPO_FRAME") if isinstance(fdat, Aggregate) else None
+        found = None if mode is None else self._value(mode.value)
+        if not (isinstance(found, EnumValue) and found.name.upper() == "TCP"):
+            return None
+        assert mode is not None
+        return (
+            f"FDAT_ACT's IPO_FRAME #TCP ({mode.value.span.location}) moves the part past a "
+            "stationary tool (external TCP), which olp does not model: the motion is the "
+            "controller's to plan, not checked"
+        )
 
     def _bas_at_run_time(self, stmt: CallStmt, command: str, reason: str) -> None:
         """Keep a BAS command with run-time values as written: the KRL post writes it back;

@@ -378,6 +378,7 @@ class _Lowering(Motions, Events):
         (:class:`olp.ir.Declare`, one per name)."""
         self.data.declare(stmt, self.variables.declare, local=True)
         for item in stmt.items:
+            self.ctx.declared_types[item.name.upper()] = stmt.type_name.upper()
             dims = tuple(to_expr(d, self._input_of) for d in item.dims or ())
             value = None if item.value is None else self._expr(item.value)
             self.out.append(
@@ -634,7 +635,7 @@ class _Lowering(Motions, Events):
             )
         if not counts:
             self._ignore(stmt, f"the FOR loop runs 0 times ({start} TO {end} STEP {step})")
-        elif self._lowers_as_block(stmt):
+        elif self._lowers_as_block(stmt, counts[0]):
             self._for_block(stmt)
             return
         else:
@@ -645,19 +646,32 @@ class _Lowering(Motions, Events):
             )
         self._unroll(stmt, counts)
 
-    def _lowers_as_block(self, stmt: ForLoop) -> bool:
-        """Whether the body lowers with the counter unknown (then the loop stays a loop)."""
-        probe = self._child(loop=True, probe=True)
+    def _lowers_as_block(self, stmt: ForLoop, first: int) -> bool:
+        """Whether the body lowers with the counter unknown (then the loop stays a loop): with
+        no motion to a run-time target, or with as many as when the counter is ``first`` (the
+        targets are the run's whatever the counter: ``LIN pts[i]`` of an array declared in a
+        file olp was not given; unrolling would only repeat run-time motions)."""
         unknown = Unknown(f"{stmt.counter} counts the FOR loop at line {stmt.span.line}")
-        probe.variables.assign(stmt.counter.upper(), unknown)
-        self.ctx.probing_for += 1
+        if self._probe_for(stmt, unknown, runtime=False) is not None:
+            return True
+        blind = self._probe_for(stmt, unknown, runtime=True)
+        known = self._probe_for(stmt, Num(float(first), True, stmt.span), runtime=True)
+        return blind is not None and blind == known
+
+    def _probe_for(self, stmt: ForLoop, counter: Value, runtime: bool) -> int | None:
+        """The run-time motions of a FOR body lowered once with ``counter``, None where it does
+        not lower (``runtime`` False: a motion to a run-time target does not lower either)."""
+        probe = self._child(loop=True, probe=True)
+        probe.variables.assign(stmt.counter.upper(), counter)
+        probing = self.ctx.probing_for
+        self.ctx.probing_for = 0 if runtime else probing + 1
         try:
             probe.lower_body(stmt.body)
         except ParseError:
-            return False
+            return None
         finally:
-            self.ctx.probing_for -= 1
-        return True
+            self.ctx.probing_for = probing
+        return sum(isinstance(n, ir.RuntimeMove) for n in leaves(probe.out))
 
     def _unroll(self, stmt: ForLoop, counts: range) -> None:
         counter = stmt.counter.upper()
@@ -774,16 +788,41 @@ class _Lowering(Motions, Events):
         assigns are unknown, motion settings it changes are ambiguous and the position it changes
         is unknown from the loop's start on (one pass of the data-flow reaches the fixpoint:
         "changed by the body" does not grow on a second pass)."""
+        where = f"the {keyword} at line {span.line}"
+        unset = self._set_by_earlier_pass(body, where)
         probe = self._child(loop=True, probe=True)
         probe.lower_body(body)
-        where = f"the {keyword} at line {span.line}"
         for name in sorted(probe.variables.changed_since(self.variables)):
             reason = f"{name} may be changed by a pass of {where}"
-            self.variables.assign(name, joined([probe.variables.lookup(name)], reason))
+            value = joined([probe.variables.lookup(name)], reason)
+            past = isinstance(value, PastFor)  # read past its unrolled FOR: an error stays one
+            self.variables.assign(name, value if past else unset.get(name, value))
         self._merge_states([self, probe], where)
         child, lowered = self._branch(body, loop=True)
         self._join([child], keyword, span, fallthrough=True)
         return lowered
+
+    def _set_by_earlier_pass(self, body: Sequence[Stmt], where: str) -> dict[str, Unknown]:
+        """A variable without a value before a loop that the loop's body assigns: a pass may
+        read it after an earlier pass assigned it (``LOOP SWITCH cmd CASE 1 $BASE = aux CASE 2
+        aux = ...``), so at the loop's start it holds what the body left, known only when the
+        program runs, as after an IF that assigns it on one path (:func:`joined`). A pass that
+        reads it before any pass assigned it stops the controller; olp cannot tell which pass
+        comes first, and says so when the value is needed. Returns those variables' values."""
+        unset: dict[str, Unknown] = {}
+        for name in sorted(assigned_names(body)):
+            value = self.variables.lookup(name)
+            if isinstance(value, Unknown) and value.missing and self.variables.is_declared(name):
+                lines = _assignment_lines(body, name)
+                reason = (
+                    f"{name} has no value before {where} and gets one in its body ({lines}): "
+                    "a pass reads the value an earlier pass left, known only when the "
+                    "program runs (a first pass that reads it before assigning it stops the "
+                    "controller)"
+                )
+                unset[name] = Unknown(reason)
+                self.variables.assign(name, unset[name])
+        return unset
 
     def _join(
         self,
@@ -833,6 +872,12 @@ class _Lowering(Motions, Events):
         if any(t != tracks[0] for t in tracks[1:]):
             self.track = dataclasses.replace(tracks[0])
             reason = f"the paths through {where} end at different positions"
+            if any(
+                t.cartesian is None and isinstance(t.no_cartesian, RuntimeStart) for t in tracks
+            ):
+                # one path ends where only the run knows: so does the join (a motion that
+                # refers to its start is a run-time motion, as after that path alone)
+                reason = RuntimeStart(f"{reason}, one known only when the program runs")
             self.track.lose_cartesian(reason)
             self.track.joints, self.track.no_joints = None, reason
         else:
@@ -1012,6 +1057,9 @@ def lower_module(
             lowering.defining = main.name
         lowering.routine = RoutineJumps.of(main.body)
         ctx.called.add(main.name.upper())
+        started = _started_elsewhere(main, routines)
+        if started is not None:
+            lowering.track.lose(RuntimeStart(started))
         lowering.first_pass(main.body)
         lowering.lower_body(main.body)
         lowering.report_unwritten_settings()
@@ -1062,6 +1110,27 @@ def _main(routines: Sequence[Routine], src: str) -> Routine | None:
     if first.kind == "DEF" or first.name.upper() == stem.upper():
         return first
     return next((r for r in routines if r.kind == "DEF"), None)
+
+
+def _started_elsewhere(main: Routine, routines: Sequence[Routine]) -> str | None:
+    """Why the robot's position when ``main`` starts is known only when the program runs, else
+    None: it takes parameters (a caller in another module gives them, from wherever that left
+    the robot), or an ``INTERRUPT DECL`` of the module runs it (from wherever the interrupt
+    stops the robot). A motion that refers to its start (``LIN_REL {X -10} #TOOL`` first)
+    is then a run-time motion. A program without either starts where the robot stands when
+    it is selected, which the controller's first motion (its BCO run) must not depend on:
+    such a motion stays an error."""
+    if main.params:
+        return f"{main.name} takes parameters: it starts where its caller left the robot"
+    for routine in routines:
+        for stmt in statements(routine.body):
+            action = stmt.action if isinstance(stmt, InterruptDecl) else None
+            if isinstance(action, CallStmt) and action.name.upper() == main.name.upper():
+                return (
+                    f"{main.name} runs from the INTERRUPT DECL at line {stmt.span.line}: it "
+                    "starts where the interrupt stops the robot"
+                )
+    return None
 
 
 def _variables(values: Any, ctx: Context, main: Routine | None) -> Variables:
@@ -1157,6 +1226,18 @@ def _routines(module: Module, sources: SourceSet, src: str) -> list[Routine]:
             raise sources.error(f"{routine.kind} {routine.name} is defined twice", routine.span)
         seen.add(routine.name.upper())
     return routines
+
+
+def _assignment_lines(body: Sequence[Stmt], name: str) -> str:
+    """The lines (comma separated) where ``body`` assigns the variable ``name`` (upper case)."""
+    lines = [
+        s.span.line
+        for s in statements(body)
+        if (isinstance(s, Assign) and s.target.name.upper() == name)
+        or (isinstance(s, ForLoop) and s.counter.upper() == name)
+    ]
+    found = sorted(set(lines))
+    return f"line{'s' if len(found) > 1 else ''} {', '.join(str(line) for line in found)}"
 
 
 def _count_assign(stmt: ForLoop, count: int) -> ir.Assign:

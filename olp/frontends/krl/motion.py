@@ -37,6 +37,7 @@ from olp.frontends.krl.state import (
 )
 from olp.frontends.krl.values import (
     AXES,
+    AXIS_TYPES,
     CARTESIAN,
     EXTERNAL,
     Unknown,
@@ -219,7 +220,7 @@ class Motions(InlineForms):
         runtime = None if self.ctx.probing_for else self._runtime_target(stmt)
         if runtime is None and not self.ctx.probing_for:
             runtime = self._runtime_start(stmt, base)
-        elif runtime is not None and relative:
+        elif runtime is not None and relative and self._start_relative(stmt, base) is None:
             self._keep_runtime_motion(stmt, base, runtime)
             return
         if stmt.with_clause:
@@ -321,7 +322,22 @@ class Motions(InlineForms):
             value = self._value(target)
             if isinstance(value, Aggregate) and is_axis_aggregate(value):
                 return "axes"
+            if isinstance(value, Unknown):  # offsets of the axes or of the position: its type
+                declared = self._declared_type(target)
+                if declared is None:
+                    return None
+                if declared in AXIS_TYPES:
+                    return "axes"
         return "tool" if option == "TOOL" else "base"
+
+    def _declared_type(self, target: Expr) -> str | None:
+        """The type (upper case) a routine's DECL gives the plain variable ``target``, where it
+        is one olp knows to be a position (``AXIS``, ``E6AXIS``, ``POS``, ``E6POS``,
+        ``FRAME``), else None."""
+        if not isinstance(target, Var) or target.selectors:
+            return None
+        declared = self.ctx.declared_types.get(target.name.upper())
+        return declared if declared in _POSITION_TYPES else None
 
     @staticmethod
     def _partial_kind(stmt: MotionStmt, base: str) -> RelativeKind | None:
@@ -893,6 +909,7 @@ def _offset(start: tuple[float, ...], delta: tuple[float, ...], option: str) -> 
     return tuple(float(v) for v in pose_to_frame(pose))
 
 
+_POSITION_TYPES = frozenset({"AXIS", "E6AXIS", "POS", "E6POS", "FRAME"})
 _RUNTIME_KINDS: dict[str, Any] = {"PTP": "joint", "LIN": "linear", "CIRC": "circular"}
 
 RelativeKind = Literal["base", "tool", "axes", "start"]

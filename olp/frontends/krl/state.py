@@ -345,6 +345,9 @@ class Context:
         # > 0 while a FOR body is tried with its counter unknown: a motion to a run-time
         # target then fails the try, so that the loop is unrolled and its targets known
         self.probing_for = 0
+        # name (upper case) -> the type a routine's DECL gives it (AXIS, E6POS, ...): what a
+        # PTP_REL by a run-time value offsets, the axes or the position
+        self.declared_types: dict[str, str] = {}
 
     def keeps_settings(self, name: str) -> bool:
         """Whether the user vouched that the unread routine ``name`` leaves the motion settings
@@ -937,8 +940,13 @@ class Core:
             ambiguous.pop(name, None)
 
     def _reset_start(self, state: State, name: str, span: ir.SourceSpan) -> None:
+        """A new tool or base: the start in its terms is unknown to olp. One the run already
+        decides (:class:`~olp.frontends.krl.motion.RuntimeStart`) stays the run's."""
+        from olp.frontends.krl.motion import RuntimeStart  # (motion.py builds on this module)
+
         self.state = state
-        self.track.lose_cartesian(f"{name} changed at line {span.line}")
+        if not isinstance(self.track.no_cartesian, RuntimeStart) or self.track.cartesian:
+            self.track.lose_cartesian(f"{name} changed at line {span.line}")
 
     def _frame_value(
         self, value: Expr, name: str, span: ir.SourceSpan, make: Callable[..., _F], null: _F
