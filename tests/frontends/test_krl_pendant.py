@@ -623,7 +623,6 @@ def test_signals_from_config(config: KrlData) -> None:
 @pytest.mark.parametrize(
     ("body", "line", "column", "message"),
     [
-        (["SPLINE", f"  SPL {FULL}", "ENDSPLINE"], 2, 1, "SPLINE ... ENDSPLINE blocks (lines 2-4)"),
         ([f"SPTP {FULL} C_VEL"], 2, 1, "C_SPL"),
         ([f"LIN {FULL} #TOOL"], 2, len(f"LIN {FULL} #"), "only the _REL motions"),
         (["$IPO_MODE = #TCP"], 2, 13, "#TCP"),
@@ -636,6 +635,33 @@ def test_lowering_errors(body: list[str], line: int, column: int, message: str) 
     error = parse_error(*body, data=dat(), cfg=load_config_dat(CONFIG))
     assert error.span is not None and (error.span.line, error.span.column) == (line, column)
     assert message in error.message
+
+
+def test_a_spline_block_is_kept_as_written_and_the_start_after_it_is_unknown() -> None:
+    """``SPLINE ... ENDSPLINE`` (before: an error): each line kept as written for the KRL post,
+    its comments as comments, the settings olp absorbed before it kept before it, a note that
+    it is not checked; a LIN_REL after it moves from where the block left the robot."""
+    body = [
+        "$VEL.CP = 0.3",
+        "SPLINE ; seam",
+        f"  SPL {FULL} WITH $VEL.CP = 0.5",
+        "  SLIN {X 2,Y 3,Z 4,A 0,B 0,C 0}",
+        "ENDSPLINE",
+        "LIN_REL {Z 50}",
+    ]
+    result = parse(*body)
+    kept = [(n.text, n.span.line) for n in result.program if isinstance(n, ir.Verbatim)]
+    assert kept == [
+        ("$VEL.CP = 0.3", 2),
+        ("SPLINE", 3),
+        (f"SPL {FULL} WITH $VEL.CP = 0.5", 4),
+        ("SLIN {X 2,Y 3,Z 4,A 0,B 0,C 0}", 5),
+        ("ENDSPLINE", 6),
+    ]
+    assert [n.text for n in result.program if isinstance(n, ir.Comment)] == [" seam"]
+    assert any("SPLINE block (lines 3-6) kept as written" in n.message for n in result.notes)
+    (rel,) = [n for n in result.program if isinstance(n, ir.RuntimeMove)]
+    assert rel.relative == "base" and rel.span.line == 7
 
 
 def test_status_out_of_range_is_located() -> None:

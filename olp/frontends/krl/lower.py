@@ -709,14 +709,45 @@ class _Lowering(Motions, Events):
 
     def _block(self, stmt: Block) -> None:
         if stmt.keyword in ("SPLINE", "PTP_SPLINE"):
-            raise self._error(
-                f"{stmt.keyword} ... ENDSPLINE blocks (lines {stmt.span.line}-"
-                f"{stmt.span.end_line}) are not supported yet",
-                stmt.span,
-                hint="olp lowers single SPTP, SLIN and SCIRC motions; write the segments as those",
-            )
+            self._keep_spline_block(stmt)
+            return
         self.motion_count += 1  # a block may move the robot: a held $POS_ACT is stale after it
         self._blocks[stmt.keyword](stmt)
+
+    def _keep_spline_block(self, stmt: Block) -> None:
+        """A ``SPLINE ... ENDSPLINE`` (``PTP_SPLINE``) block, kept as written line by line for
+        the KRL post (its comments as comments): olp does not model the spline path through
+        its SPL points (KUKA's spline is not published; a guess would be checked as if it were
+        the path), so the block is not checked (reach, limits, collisions) nor timed, with a
+        warning; other posts refuse its lines. It runs with the settings the controller holds:
+        the ones olp absorbed since the last motion are kept before it, and the robot is where
+        olp does not know after it (a _REL motion then is a run-time one)."""
+        self.motion_count += 1
+        self._keep_unwritten(
+            f"sets motion settings before the {stmt.keyword} block at line {stmt.span.line}, "
+            "kept as written (olp writes none before it)"
+        )
+        source = self.sources.source(stmt.span.file)
+        last = stmt.span.end_line or stmt.span.line
+        reason = f"a line of the {stmt.keyword} block at line {stmt.span.line}: not modelled"
+        for number in range(stmt.span.line, last + 1):
+            line = (source.line(number) if source is not None else None) or ""
+            code = code_of(line)
+            if code:
+                start = line.index(code) + 1
+                span = ir.SourceSpan(stmt.span.file, number, start, number, start + len(code))
+                self._keep_text(code, span, reason)
+            rest = line.strip()[len(code) :].strip() if code else line.strip()
+            if rest.startswith(";"):
+                span = ir.SourceSpan(stmt.span.file, number, line.index(";") + 1)
+                self.out.append(ir.Comment(text=rest[1:], span=span, from_source=True))
+        self._note(
+            stmt.span,
+            f"{stmt.keyword} block (lines {stmt.span.line}-{last}) kept as written: olp does not "
+            "model the spline path, so its motions are not checked (reach, limits, collisions) "
+            "nor timed, and the motion after it starts where olp does not know",
+        )
+        self.track.lose(RuntimeStart(f"the {stmt.keyword} block at line {stmt.span.line} moves"))
 
     def _if(self, stmt: Block) -> None:
         condition = self._expr(stmt.conditions[0])
