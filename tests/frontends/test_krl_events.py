@@ -86,9 +86,11 @@ def test_triggers_are_in_si_units_and_keep_their_reference_point() -> None:
     assert (closing.at, closing.priority) == ("end", None)
 
 
-def test_the_pendants_stop_message_interrupt_stays_out(tmp_path: Path) -> None:
-    """The KUKA post writes interrupt 3 in every INI: keeping the source's would declare it
-    twice. Another interrupt 3 (other condition) is the program's own and is kept."""
+def test_the_pendants_stop_message_interrupt_is_kept_for_the_krl_post(tmp_path: Path) -> None:
+    """The pendant's stop-message interrupt 3 and its INTERRUPT ON are KUKA's own lines: kept
+    as written for the KRL post alone, wherever they stand (the KUKA post writes no INI of its
+    own for a KRL program); another interrupt 3 (other condition) is the program's own,
+    modelled."""
     path = program_file(
         tmp_path,
         "GLOBAL INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )",
@@ -98,8 +100,9 @@ def test_the_pendants_stop_message_interrupt_stays_out(tmp_path: Path) -> None:
     )
     found = events(path)
     assert [(n.kind, n.span.line) for n in found] == [("interrupt_decl", 4), ("interrupt", 5)]
-    ignored = [i.span.line for i in load_krl(path, CONFIG).ignored if i.span.file == str(path)]
-    assert ignored == [2, 3]
+    program = load_krl(path, CONFIG).program
+    kept = [(n.span.line, n.native_only) for n in program if isinstance(n, ir.Verbatim)]
+    assert kept == [(2, True), (3, True)]
 
 
 @pytest.mark.parametrize(

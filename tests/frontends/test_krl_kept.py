@@ -10,7 +10,7 @@ import pytest
 import olp
 from olp import ir
 from olp.frontends.bundled import KrlOptions
-from olp.frontends.krl import load_krl
+from olp.frontends.krl import load_krl, parse_krl
 
 REPO = Path(__file__).resolve().parents[2]
 STATION = REPO / "stations" / "kr6_milling_cell.yaml"
@@ -203,6 +203,22 @@ def test_a_held_pos_act_is_stale_after_a_block_that_may_move(tmp_path: Path) -> 
     program = load_krl(path, CORPUS / "System" / "$config.dat").program
     (moved,) = [n for n in program if isinstance(n, ir.RuntimeMove)]
     assert moved.motion == "joint" and moved.speed.joint == pytest.approx(0.1)
+
+
+def test_a_held_pos_act_is_stale_after_a_plain_motion() -> None:
+    """A plain LIN between ``pAct = $POS_ACT`` and ``LIN pAct`` moves the robot away: the LIN
+    back is a motion to a run-time target, not "where the robot already is" (the simple
+    motions olp reads on its fast path were not counted, so it was kept as no motion, and the
+    next motion was taken to start at the LIN's end)."""
+    text = (
+        "DEF h( )\nDECL E6POS pAct\n$BASE = $NULLFRAME\n$TOOL = $NULLFRAME\n$VEL.CP = 0.2\n"
+        "PTP {A1 0,A2 -90,A3 90,A4 0,A5 45,A6 0}\npAct = $POS_ACT\n"
+        "LIN {X 500,Y 0,Z 600,A 0,B 90,C 0}\nLIN pAct\nEND\n"
+    )
+    program = parse_krl(text, "h.src").program
+    assert [n for n in program if isinstance(n, ir.Verbatim)] == []
+    (back,) = [n for n in program if isinstance(n, ir.RuntimeMove)]
+    assert back.span.line == 9 and "$POS_ACT" in back.reason
 
 
 def test_after_a_call_that_may_move_a_with_motion_is_kept_as_written(tmp_path: Path) -> None:

@@ -34,7 +34,10 @@ from olp.frontends.krl.flow import to_expr
 from olp.frontends.krl.state import Core
 from olp.frontends.krl.values import Unknown
 
-STANDARD_STOP = "the pendant's standard stop-message interrupt: the KUKA post writes it in the INI"
+STANDARD_STOP = (
+    "the pendant's standard stop-message interrupt: the KUKA post writes it where the KRL "
+    "source had it (the other posts' controllers handle stop messages themselves)"
+)
 MM, MS = 1e-3, 1e-3
 
 

@@ -63,7 +63,7 @@ from olp.frontends.krl.flow import (
 )
 from olp.frontends.krl.module_data import with_module_data
 from olp.frontends.krl.motion import Motions, RuntimeStart
-from olp.frontends.krl.native import INI_TITLE, native_reason
+from olp.frontends.krl.native import native_reason
 from olp.frontends.krl.routines import PendingCall, assemble, moves, typed_params
 from olp.frontends.krl.rows import build_instructions
 from olp.frontends.krl.state import (
@@ -273,10 +273,11 @@ class _Lowering(Motions, Events):
     def _kept_native(self, stmt: Stmt) -> bool:
         """Keep a statement that matters only on a KUKA controller as a native-only
         :class:`olp.ir.Verbatim` (:mod:`olp.frontends.krl.native`); False for any other."""
-        in_ini = INI_TITLE in self.folds and self.motion_count == 0
-        reason = native_reason(stmt, in_ini)
+        reason = native_reason(stmt, self.motion_count == 0, self.stop_interrupt_declared)
         if reason is None:
             return False
+        # the standard declaration: the INTERRUPT ON 3 right after it is its own, kept too
+        self.stop_interrupt_declared = isinstance(stmt, InterruptDecl)
         self._keep(stmt, reason)
         kept = self.out[-1]
         assert isinstance(kept, ir.Verbatim)

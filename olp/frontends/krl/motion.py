@@ -105,6 +105,7 @@ class Motions(InlineForms):
                 self.lower_statement(motion)  # type: ignore[attr-defined]
             return
         self.ctx.remaining -= len(rows)  # what lower_statement spends per line
+        self.motion_count += len(rows)
         self._after_kept_settings(rows.span)
         state = self.state
         zone = 0.0 if state.cdis_mm is None else state.cdis_mm / 1000.0
@@ -140,8 +141,12 @@ class Motions(InlineForms):
 
     def _fast_motion(self, stmt: FastMotion) -> None:
         """The common simple motion, lowered without building its full AST; anything less
-        common goes through :meth:`_motion` with the materialised statement."""
-        if not self._lower_fast(stmt):
+        common goes through :meth:`_motion` with the materialised statement (which counts
+        itself). A motion is counted (``motion_count``) like any: a variable given $POS_ACT
+        before it no longer holds where the robot is."""
+        if self._lower_fast(stmt):
+            self.motion_count += 1
+        else:
             self._motion(materialise(stmt))
 
     def _lower_fast(self, stmt: FastMotion) -> bool:
