@@ -10,8 +10,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 import olp
 from olp import ir
+from olp.errors import ParseError
 from olp.frontends.bundled import KrlOptions
 
 STATION = Path(__file__).resolve().parents[2] / "stations" / "kr6_milling_cell.yaml"
@@ -131,3 +134,16 @@ def test_a_call_of_the_modules_own_routine_holds_nothing(tmp_path: Path) -> None
     assert result.ok, [d.format() for d in result.diagnostics]
     assert [n for n in result.compiled.program if isinstance(n, ir.RuntimeMove)] == []
     assert not [d for d in result.diagnostics if d.kind == "unknown_start"]
+
+
+def test_a_setting_in_a_block_before_an_unread_call_is_an_error(tmp_path: Path) -> None:
+    """``$VEL.CP`` set inside an IF with no motion in it, then a call of an unread routine:
+    olp writes settings only before its motions, and the motion after the call runs with the
+    controller's settings, so on that path the setting would never reach the controller; a
+    located error, not a silent drop."""
+    text = CELL.replace(
+        "SetFrames(1, 2)\n", "IF $IN[1] THEN\n$VEL.CP = 0.1\nENDIF\nSetFrames(1, 2)\n"
+    )
+    with pytest.raises(ParseError, match="inside a block no motion of which runs with them") as err:
+        _build(tmp_path, text)
+    assert err.value.span is not None and err.value.span.line == 6

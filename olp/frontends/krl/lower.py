@@ -326,7 +326,8 @@ class _Lowering(Motions, Events):
         one inside a block olp lowered already is left out with a warning."""
         self._keep_unwritten(
             "sets motion settings after the module's last motion: kept as written for what "
-            "runs after it (a caller)"
+            "runs after it (a caller)",
+            strict=False,
         )
         for stmt in self.unwritten:
             self._ignore(

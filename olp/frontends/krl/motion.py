@@ -465,22 +465,34 @@ class Motions(InlineForms):
         )
         return True
 
-    def _keep_unwritten(self, reason: str) -> None:
+    def _keep_unwritten(self, reason: str, strict: bool = True) -> None:
         """Keep as written, where they stand and for the KRL post only
         (:attr:`olp.ir.Verbatim.native_only`), the statements olp absorbed into the motion
         settings since the last motion (``unwritten``): something that runs with the
         controller's settings comes next (a call of a routine olp did not read, a motion with
         the controller's settings, the end of the module), before which the output writes none
         of olp's. Only those in an output list still being built (``live_outs``: this
-        lowering's and those it is nested in); one inside a block already lowered stays
-        waiting for a motion, or is reported at the end (:meth:`report_unwritten_settings`).
-        One a kept BAS already wrote (a data record it reads) is not written twice."""
+        lowering's and those it is nested in). One inside a block already lowered cannot be
+        kept where it stands: with ``strict`` (a call or motion with the controller's settings
+        comes next, which would run without it on that path) that is an error at it, else it
+        is reported at the end (:meth:`report_unwritten_settings`). One a kept BAS already wrote
+        (a data record it reads) is not written twice."""
         unwritten: list[Any] = getattr(self, "unwritten", [])
         positions: list[tuple[list[Any], int]] = getattr(self, "unwritten_at", [])
         live = [*getattr(self, "live_outs", []), self.out]
         for k in range(len(unwritten) - 1, -1, -1):  # from the back: earlier positions hold
             out, at = positions[k]
             if not any(out is candidate for candidate in live):
+                if strict:
+                    raise self._error(
+                        "this statement sets motion settings inside a block no motion of which "
+                        "runs with them, and what follows the block runs with the controller's "
+                        "settings (a call of a routine olp did not read, or a motion after one): "
+                        "olp writes settings only before its motions, so on this path the "
+                        "controller would run without it",
+                        unwritten[k].span,
+                        hint="set it after the block, or give the block a motion that uses it",
+                    )
                 continue
             stmt = unwritten.pop(k)
             del positions[k]
