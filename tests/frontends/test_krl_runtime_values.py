@@ -303,3 +303,22 @@ def test_an_unrolled_pass_that_does_not_read_the_counter_is_written_as_before(
     text = "\n".join(["DEF t( )", "DECL INT i", *FRAMES, "FOR i = 1 TO 2", "  PTP corner[i]"])
     result = parse_krl(text + "\nENDFOR\nEND\n", "t.src", dat=data, config=config)
     assert [n.kind for n in result.program.instructions] == ["declare", "joint", "joint"]
+
+
+SPLINE_FORM = (
+    "SPTP XP1 WITH $VEL_AXIS[1] = SVEL_JOINT(100.0), $TOOL = STOOL2(FP1), "
+    "$BASE = SBASE(FP1.BASE_NO), $ACC_AXIS[1] = SACC_JOINT(PPDAT1)"
+)
+"""A spline inline form: its WITH sets every setting a PTP runs with, for that motion."""
+
+
+def test_a_spline_form_after_an_unread_call_sets_its_own_settings(config: KrlData) -> None:
+    """After a call of a routine olp did not read, every setting is the controller's; a WITH
+    that sets all a PTP uses makes it a modelled motion (its own WITH items are not ambiguous
+    for it). The plain PTP after it still runs with the controller's settings (the WITH's
+    values hold for that motion only)."""
+    text = "\n".join(["DEF t( )", "Foo()", SPLINE_FORM, "PTP XP1", "END", ""])
+    result = parse_krl(text, "t.src", dat=_inline_data(), config=config)
+    assert [m.span.line for m in result.program.motions()] == [3]
+    (after,) = [n for n in result.program if isinstance(n, ir.RuntimeMove)]
+    assert after.span.line == 4 and after.controller_settings
