@@ -61,7 +61,8 @@ before the motion that runs with them; and a statement the written ``.src`` says
 numbers otherwise spelt, ``WAIT SEC 0`` as ``WAIT SEC 0.000``, ``$VEL.CP=2`` as
 ``$VEL.CP = 2.0``, or a declaration item by item, ``INT a, b`` as ``DECL INT a`` and ``DECL INT
 b``); ``statements_lost_krl``: the rest, not in the output in any spelling (with ``-v``: the
-texts lost most often, and the rewritten ones by kind).
+texts lost most often, and the rewritten ones by kind; with ``--lost``: each lost one as
+``file:line: text``).
 
 The last lines are ``name: value unit``.
 """
@@ -130,6 +131,7 @@ class TextCount:
     lost: collections.Counter[str] = field(default_factory=collections.Counter)
     routine_lines: int = 0
     routine_lines_lost: collections.Counter[str] = field(default_factory=collections.Counter)
+    where_lost: list[str] = field(default_factory=list)  # ``file:line: text`` of each lost one
 
 
 def construct_of(message: str, source_line: str | None) -> str:
@@ -303,6 +305,7 @@ def count_text(text: str, src: str, result: object, count: TextCount) -> None:
             count.found += not routine
         elif routine:
             count.routine_lines_lost[key] += 1
+            count.where_lost.append(f"{src}:{number}: {line.strip()[:100]}")
         else:
             unmatched.append((number, line))
     # then what the post writes in its own spelling, from the written statements left over
@@ -315,6 +318,7 @@ def count_text(text: str, src: str, result: object, count: TextCount) -> None:
             count.rewritten[_kind(line)] += 1
         else:
             count.lost[normalised(line)] += 1
+            count.where_lost.append(f"{src}:{number}: {line.strip()[:100]}")
 
 
 def _respelt(left: collections.Counter[str], line: str) -> bool:
@@ -610,6 +614,9 @@ def main() -> None:
     parser.add_argument("--post", default="kuka")
     parser.add_argument("--backups", action="store_true", help="each subfolder is one backup")
     parser.add_argument("-v", "--verbose", action="store_true")
+    parser.add_argument(
+        "--lost", action="store_true", help="list each statement lost in the KRL text"
+    )
     args = parser.parse_args()
     start = time.perf_counter()
     if args.backups:
@@ -648,6 +655,9 @@ def main() -> None:
         print(f"  KRL -> KRL differs {name}")
     print(f"krl_round_trip_differs: {len(tally.round_trip_differs)} files")
     print_text_count(tally.text, args.verbose)
+    if args.lost:
+        for where in tally.text.where_lost:
+            print(f"  lost at {where}")
     for line in tally.comments_lost[:20]:
         print(f"  comment lost {line}")
     print(f"comments_in: {tally.comments_in} lines")
