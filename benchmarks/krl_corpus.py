@@ -312,13 +312,25 @@ def count_text(text: str, src: str, result: object, count: TextCount) -> None:
     numbers: collections.Counter[str] = collections.Counter()
     for key, left in written.items():
         numbers[spelt[key]] += left
+    untils = collections.Counter(_bare(k) for k, n in numbers.items() for _ in range(n))
     for number, line in unmatched:
         lowered_here = number in lowered or _REWRITTEN.match(line) or _MOTION.match(line)
-        if lowered_here or _respelt(numbers, line):
+        until = _UNTIL.match(line) is not None and _take(untils, [_bare(same_numbers(line))])
+        if lowered_here or until or _respelt(numbers, line):
             count.rewritten[_kind(line)] += 1
         else:
             count.lost[normalised(line)] += 1
             count.where_lost.append(f"{src}:{number}: {line.strip()[:100]}")
+
+
+_UNTIL = re.compile(r"(?i)\s*UNTIL\b")
+
+
+def _bare(key: str) -> str:
+    """A REPEAT's condition without parentheses: the post writes the condition it parsed with
+    the parentheses its operators need (``UNTIL (a==TRUE)`` as ``UNTIL a == TRUE``), and the
+    UNTIL line carries no span of its own in the IR (the REPEAT's is the block's)."""
+    return key.replace("(", "").replace(")", "")
 
 
 def _respelt(left: collections.Counter[str], line: str) -> bool:

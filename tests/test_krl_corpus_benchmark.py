@@ -43,6 +43,16 @@ def test_a_number_inside_a_string_is_not_respelt() -> None:
     assert dict(count.lost) == {'MSG("BOX1")': 1}
 
 
+def test_an_until_written_without_its_parentheses_is_rewritten_and_an_absent_one_lost() -> None:
+    source = "DEF cell( )\nREPEAT\nWAIT SEC 1\nUNTIL ($IN[1]==TRUE)\nUNTIL ($IN[2])\nEND\n"
+    out = "DEF cell( )\nREPEAT\nWAIT SEC 1\nUNTIL $IN[1] == TRUE\nEND\n"
+    count = TextCount()
+    count_text(source, "cell.src", written(out), count)
+    assert sum(count.rewritten.values()) == 1
+    assert dict(count.lost) == {"UNTIL($IN[2])": 1}
+    assert count.where_lost == ["cell.src:5: UNTIL ($IN[2])"]
+
+
 def test_a_file_that_is_not_krl_is_counted_apart(tmp_path: Path) -> None:
     (tmp_path / "todo.src").write_text("DEF todo( )\n   TODO\nEND\n", encoding="latin-1")
     (tmp_path / "unread.src").write_text("DEF unread( )\n   ASYSTOP\nEND\n", encoding="latin-1")
