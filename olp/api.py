@@ -180,7 +180,8 @@ def build(
     # The post walks the steps several times: a toolpath's rows are made into steps once here,
     # unless its row writer takes them as columns (Post.render_form).
     compiled, prepared = writer.prepare(writer.render_form(compiled))
-    diagnostics = diagnostics + tuple(prepared) + tuple(writer.check(compiled))
+    checked = [*prepared, *writer.check(compiled), *writer.renamed(compiled.program, name)]
+    diagnostics = diagnostics + tuple(checked)
     if has_errors(diagnostics):
         return BuildResult(compiled, writer.name, diagnostics)
     from olp import progress

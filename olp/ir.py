@@ -931,6 +931,10 @@ class Program:
     post of that language writes what the source said where it would otherwise add text of
     its own (the KUKA post writes a KRL source's INI fold where it had one and none where it
     had none; a program from elsewhere gets the template's).
+
+    ``exported``: the source marks the program visible to other modules (KRL ``GLOBAL DEF``;
+    a module's first routine is visible without it, so the mark changes nothing): a post of
+    the source's language writes it back, so the line reads as it did.
     """
 
     name: str
@@ -941,6 +945,7 @@ class Program:
     returns: str | None = None
     returns_dims: tuple[_flow.Expr | None, ...] = ()
     language: str | None = None
+    exported: bool = False
 
     def __post_init__(self) -> None:
         if not isinstance(self.instructions, tuple):

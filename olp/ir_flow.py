@@ -567,10 +567,15 @@ class Branch:
 @dataclass(frozen=True, slots=True, kw_only=True)
 class If:
     """``if / else if ... / else``: the first ``branches`` arm whose condition holds runs, else
-    ``orelse``."""
+    ``orelse``.
+
+    ``has_else``: the source writes an else arm even where ``orelse`` is empty (a KRL ``ELSE``
+    followed only by blank lines); a post of the source's own language writes it back, so a
+    program read and written in one language keeps the line. An empty arm does nothing."""
 
     branches: tuple[Branch, ...]
     orelse: tuple[Node, ...] = ()
+    has_else: bool = False
     span: SourceSpan = GENERATED
     kind: Literal["if"] = field(default="if", init=False)
 
@@ -596,11 +601,15 @@ class Case:
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Switch:
-    """``switch subject``: the first case with a matching value runs, else ``default``."""
+    """``switch subject``: the first case with a matching value runs, else ``default``.
+
+    ``has_default``: the source writes a default arm even where ``default`` is empty (see
+    :attr:`If.has_else`)."""
 
     subject: Expr
     cases: tuple[Case, ...]
     default: tuple[Node, ...] = ()
+    has_default: bool = False
     span: SourceSpan = GENERATED
     kind: Literal["switch"] = field(default="switch", init=False)
 

@@ -53,7 +53,7 @@ from numpy.typing import NDArray
 
 from olp.diagnostics import Diagnostic
 from olp.errors import PostError
-from olp.ir import ArcOrientation, Program
+from olp.ir import GENERATED, ArcOrientation, Program, SourceSpan
 from olp.posts.numbers import NumberError, NumberFormat, format_number, format_numbers
 from olp.posts.sandbox import PostSandbox, make_environment
 from olp.posts.text import (
@@ -589,6 +589,23 @@ class Post:
 
     # ----------------------------------------------------------------------------------------
     # Shared checks
+
+    def renamed(self, program: Program, name: str | None = None) -> list[Diagnostic]:
+        """A warning where the program's file and routine get another name than asked for
+        (``name``, else the program's own): one the language does not allow (KRL: longer than
+        24 characters, :attr:`NAME_RULE`) is made legal, and other programs that call it by the
+        old name would no longer find it."""
+        wanted = name or program.name
+        if self.NAME_RULE.is_legal(wanted):
+            return []
+        legal = self.NAME_RULE.legal(wanted)
+        message = (
+            f"the program is written as {legal}: {_quote(wanted)} is not a legal "
+            f"{self.LANGUAGE} name ({self.NAME_RULE.describe()}); a program that calls it by "
+            "that name must call it by the new one"
+        )
+        span = SourceSpan(program.source, 1, 1) if program.source != "<memory>" else GENERATED
+        return [Diagnostic("warning", "renamed", message, span)]
 
     def _foreign_robot(self, compiled: CompiledProgram) -> list[Diagnostic]:
         robot = compiled.station.robot

@@ -47,14 +47,17 @@ _CLOSERS = {
 }
 
 
-def weave(program: ir.Program, steps: Sequence[PostStep]) -> list[PostStep]:
+def weave(
+    program: ir.Program, steps: Sequence[PostStep], empty_arms: bool = False
+) -> list[PostStep]:
     """``steps`` (one per instruction, in the order iterating ``program`` gives) with the
     program's block markers woven in and the declarations first; see the module docstring.
     A routine's body expanded at a call (:class:`olp.ir.Expanded`) is the one marker
     ``routine_call`` (``instruction``: the :class:`olp.ir.RoutineCall`); its steps are the
-    routine's (:func:`weave_routines`)."""
+    routine's (:func:`weave_routines`). ``empty_arms``: write the else and default arms the
+    source wrote empty (:attr:`olp.ir.If.has_else`; a post of the program's own language)."""
     by_index = {s.index: s for s in steps}
-    return _ordered(list(_Weaver(by_index).nodes(program.instructions)))
+    return _ordered(list(_Weaver(by_index, empty_arms=empty_arms).nodes(program.instructions)))
 
 
 def _ordered(body: list[PostStep], fresh: bool = False) -> list[PostStep]:
@@ -117,7 +120,7 @@ def expansions(program: ir.Program) -> dict[str, list[tuple[ir.Expanded, int]]]:
 
 
 def weave_routines(
-    program: ir.Program, steps: Sequence[PostStep], lines: Any
+    program: ir.Program, steps: Sequence[PostStep], lines: Any, empty_arms: bool = False
 ) -> list[RoutineSteps]:
     """The program's routines with their steps (:class:`RoutineSteps`), in the program's
     order. A routine no call expands (a function, an interrupt handler) holds no motion: its
@@ -127,7 +130,7 @@ def weave_routines(
     out = []
     for routine in program.routines:
         found = sites.get(routine.name.upper())
-        weaver = _Weaver(by_index, lines)
+        weaver = _Weaver(by_index, lines, empty_arms)
         if found:
             node, weaver.cursor = found[0]
             body = list(weaver.nodes(node.body))
@@ -139,8 +142,11 @@ def weave_routines(
 
 
 class _Weaver:
-    def __init__(self, by_index: dict[int, PostStep], lines: Any = None) -> None:
+    def __init__(
+        self, by_index: dict[int, PostStep], lines: Any = None, empty_arms: bool = False
+    ) -> None:
         self.by_index = by_index
+        self.empty_arms = empty_arms  # write an else/default arm the source left empty
         self.cursor = 0
         self.lines = lines
         self.alone = False  # a routine without steps: its statements become steps here
@@ -180,7 +186,7 @@ class _Weaver:
             for k, branch in enumerate(node.branches):
                 yield _marker("if" if k == 0 else "elif", node if k == 0 else branch, branch.span)
                 yield from self.nodes(branch.body)
-            if node.orelse:
+            if node.orelse or (node.has_else and self.empty_arms):
                 yield _marker("else", node, node.span)
                 yield from self.nodes(node.orelse)
             yield _marker("end_if", node, node.span)
@@ -189,7 +195,7 @@ class _Weaver:
             for case in node.cases:
                 yield _marker("case", case, case.span)
                 yield from self.nodes(case.body)
-            if node.default:
+            if node.default or (node.has_default and self.empty_arms):
                 yield _marker("default", node, node.span)
                 yield from self.nodes(node.default)
             yield _marker("end_switch", node, node.span)

@@ -461,7 +461,11 @@ FILTERS: Mapping[str, Filter] = {
     "krl_routine_head": lambda post, routine: krl_routine_head(routine),
     "krl_io": lambda post, node, io: krl_io(node, io),
     "krl_program_head": lambda post, program: krl_program_head(
-        program["name"], program["params"], program["returns"], program["returns_dims"]
+        program["name"],
+        program["params"],
+        program["returns"],
+        program["returns_dims"],
+        program["exported"] and program["language"] == "krl",
     ),
     "krl_routine_end": lambda post, routine: krl_routine_end(routine),
     "krl_param_decl": lambda post, param: krl_param_decl(param),

@@ -176,6 +176,7 @@ def krl_program_head(
     params: Sequence[ir.Parameter],
     returns: str | None = None,
     returns_dims: Sequence[ir.Expr | None] = (),
+    exported: bool = False,
 ) -> str:
     """The program's ``DEF``: ``DEF name( )`` as the pendant writes a program without
     parameters, ``DEF name(p:IN, q:OUT)`` for one that other modules call with arguments
@@ -184,11 +185,16 @@ def krl_program_head(
     for a program that gives a result (:attr:`olp.ir.Program.returns`: a module whose first
     routine is a function, which other modules call in an expression; it ends with
     ``ENDFCT``). The module's first routine is the one other modules call by the module's
-    name, so it needs no ``GLOBAL``."""
+    name, so it needs no ``GLOBAL``; ``exported`` writes one where a KRL source had it
+    (:attr:`olp.ir.Program.exported`), so the line reads as it did."""
     if not params and returns is None:
-        return f"DEF {name}( )"
+        return f"{'GLOBAL ' if exported else ''}DEF {name}( )"
     head = ir.Routine(
-        name=name, params=tuple(params), returns=returns, returns_dims=tuple(returns_dims)
+        name=name,
+        params=tuple(params),
+        returns=returns,
+        returns_dims=tuple(returns_dims),
+        exported=exported,
     )
     return krl_routine_head(head)
 

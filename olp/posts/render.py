@@ -268,10 +268,12 @@ class _Renderer:
         routines: list[RoutineSteps] = []
         if self.post.WRITES_FLOW and self.compiled.program.has_flow:
             # a program with control flow is rendered from steps only (Post.columns_enabled)
+            language = self.compiled.program.language
+            own = language is not None and language == self.post.VERBATIM  # write empty arms
             if self.post.writes_routines():
                 lines = self.post.comment_node_lines
-                routines = weave_routines(self.compiled.program, view, lines)
-            view = weave(self.compiled.program, view)
+                routines = weave_routines(self.compiled.program, view, lines, own)
+            view = weave(self.compiled.program, view, own)
         program = self.compiled.program
         whole = index == 0
         unit = Unit(
@@ -285,6 +287,7 @@ class _Renderer:
             program.returns if whole else None,
             program.returns_dims if whole else (),
             program.language,
+            program.exported and whole,
         )
         return unit_context(
             self.post, self.compiled.station, unit, allocation, view, routines, every
@@ -320,6 +323,9 @@ class Unit:
     language: str | None = None
     """The language the program was read from (:attr:`olp.ir.Program.language`; a streamed
     build reads CSV, None)."""
+    exported: bool = False
+    """The source marks the program visible to other modules (:attr:`olp.ir.Program.exported`;
+    the whole program or the main only, never a part)."""
 
 
 def unit_context(
@@ -346,6 +352,7 @@ def unit_context(
             "returns": unit.returns,
             "returns_dims": unit.returns_dims,
             "language": unit.language,
+            "exported": unit.exported,
         },
         "split": unit.count > 0,
         "unit": {

@@ -62,6 +62,11 @@ class NameRule:
             cleaned = cut + "_"
         return cleaned
 
+    def describe(self) -> str:
+        """The rule in words, for a message."""
+        length = "" if self.max_length is None else f", at most {self.max_length} characters"
+        return f"ASCII letters, digits and '_', a letter first{length}, not a reserved word"
+
     def is_reserved(self, name: str) -> bool:
         return (name if self.case_sensitive else name.upper()) in self.reserved
 

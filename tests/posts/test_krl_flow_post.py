@@ -220,3 +220,84 @@ def test_the_error_names_an_interrupt_with_its_article(station: object) -> None:
     program = ir.Program(name="p", instructions=(switch, down(0.5, 0.1, 7)))
     errors = [d for d in build(station, program, "abb").diagnostics if d.severity == "error"]
     assert "cannot write an interrupt instruction" in errors[0].message
+
+
+EMPTY_ARMS = """DEF empty_arms( )
+DECL INT nStep
+nStep = 0
+IF $IN[3] THEN
+  nStep = 1
+ENDIF
+IF $IN[1] THEN
+  $OUT[2] = TRUE
+ELSE
+
+ENDIF
+SWITCH nStep
+CASE 1
+  $OUT[3] = TRUE
+DEFAULT
+ENDSWITCH
+END
+"""
+
+
+@pytest.mark.parametrize("post", ["kuka", "abb"])
+def test_an_else_or_default_the_source_leaves_empty_is_kept_in_its_own_language(
+    station: object, post: str, tmp_path: Path
+) -> None:
+    """A KRL ``ELSE`` or ``DEFAULT`` with nothing under it is written back by the KRL post (KRL
+    to KRL keeps every statement); another language's post leaves the empty arm out."""
+    src = tmp_path / "empty_arms.src"
+    src.write_text(EMPTY_ARMS)
+    program = load_krl(src).program
+    switch = next(n for n in program.instructions if isinstance(n, ir.Switch))
+    assert switch.has_default and not switch.default
+    result = olp.build(station, src, post=post, collisions=None)
+    assert result.ok, [d.format() for d in result.diagnostics if d.severity == "error"]
+    (text,) = [t for f, t in result.files.items() if f.endswith((".src", ".mod"))]
+    lines = [line.strip().upper() for line in text.replace("\r", "").splitlines()]
+    if post == "kuka":
+        assert lines[lines.index("ELSE") + 1] == "ENDIF"
+        assert lines[lines.index("DEFAULT") + 1] == "ENDSWITCH"
+    else:
+        assert "ELSE" not in lines and "DEFAULT:" not in lines
+
+
+@pytest.mark.parametrize("head", ["GLOBAL DEF marked( )", "DEF marked( )"])
+def test_the_program_keeps_the_global_mark_its_source_gives_it(
+    station: object, head: str, tmp_path: Path
+) -> None:
+    """``GLOBAL DEF`` on a module's first routine changes nothing on the controller (that
+    routine is visible to other modules anyway), but KRL to KRL keeps the line as it was."""
+    src = tmp_path / "marked.src"
+    src.write_text(f"{head}\n$OUT[1] = TRUE\nEND\n")
+    result = olp.build(station, src, post="kuka", collisions=None)
+    assert result.ok
+    lines = result.files["marked.src"].replace("\r", "").splitlines()
+    assert [line for line in lines if "DEF" in line] == [head]
+
+
+@pytest.mark.parametrize(
+    ("stem", "post", "written"),
+    [
+        ("pick_and_place_station_two", "kuka", "pick_and_place_station_t"),
+        ("pick_and_place_station", "kuka", None),
+        ("pick", "fanuc", None),  # Fanuc writes names in upper case: not a rename
+    ],
+)
+def test_a_program_written_under_another_name_is_a_warning(
+    station: object, stem: str, post: str, written: str | None, tmp_path: Path
+) -> None:
+    """A module renamed to fit the language (KRL: 24 characters) is no longer found by the
+    modules that call it by its old name: the build says so instead of renaming in silence."""
+    src = tmp_path / f"{stem}.src"
+    src.write_text(f"DEF {stem}( )\n$OUT[1] = TRUE\nEND\n")
+    result = olp.build(station, src, post=post, collisions=None)
+    renamed = [d for d in result.diagnostics if d.kind == "renamed"]
+    if written is None:
+        assert renamed == []
+    else:
+        (warning,) = renamed
+        assert warning.severity == "warning" and f"written as {written}:" in warning.message
+        assert f"{written}.src" in result.files

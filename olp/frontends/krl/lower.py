@@ -757,7 +757,9 @@ class _Lowering(Motions, Events):
         self._join([child for child, _ in arms], "IF", stmt.span)
         (_, then_body), (_, else_body) = arms
         branch = ir.Branch(condition=condition, body=then_body, span=stmt.span)
-        self.out.append(ir.If(branches=(branch,), orelse=else_body, span=stmt.span))
+        self.out.append(
+            ir.If(branches=(branch,), orelse=else_body, has_else=stmt.has_else, span=stmt.span)
+        )
 
     def _switch(self, stmt: Block) -> None:
         subject = self._expr(stmt.conditions[0])
@@ -768,7 +770,15 @@ class _Lowering(Motions, Events):
             for values, (_, body) in zip(stmt.cases, arms, strict=False)
         )
         default = arms[-1][1]
-        self.out.append(ir.Switch(subject=subject, cases=cases, default=default, span=stmt.span))
+        self.out.append(
+            ir.Switch(
+                subject=subject,
+                cases=cases,
+                default=default,
+                has_default=stmt.has_else,
+                span=stmt.span,
+            )
+        )
 
     def _while(self, stmt: Block) -> None:
         condition = self._expr(stmt.conditions[0])
@@ -1120,6 +1130,7 @@ def lower_module(
         returns=None if main is None else main.returns,
         returns_dims=() if main is None else _returns_dims(main),
         language="krl",
+        exported=main is not None and main.exported,
     )
     program = with_module_data(program, dat, config, shared)
     return KrlResult(
