@@ -13,6 +13,7 @@ import olp
 from olp import ir
 from olp.frontends.krl import parse_krl
 from olp.posts import find_post
+from tests.krl_notes import own_notes
 
 REPO = Path(__file__).resolve().parents[2]
 STATION = REPO / "stations" / "kr6_milling_cell.yaml"
@@ -232,4 +233,4 @@ def test_a_label_a_goto_targets_ends_the_dead_code() -> None:
 def test_the_program_override_is_kept_and_its_timing_noted() -> None:
     result = parse_krl(f"DEF slow( )\n$OV_PRO = 30\n{HOME}\nEND\n", "slow.src")
     assert [(n.kind, n.span.line) for n in result.program] == [("verbatim", 2), ("joint", 3)]
-    assert [(n.span.line, "100 %" in n.message) for n in result.notes] == [(2, True)]
+    assert [(n.span.line, "100 %" in n.message) for n in own_notes(result.notes)] == [(2, True)]

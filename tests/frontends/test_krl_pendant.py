@@ -24,6 +24,7 @@ from olp.frontends.krl import (
 )
 from olp.frontends.krl import lower as krl_lower
 from olp.vendors.kuka import configuration_from_status_turn, frame_to_pose
+from tests.krl_notes import own_notes
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 PICK = EXAMPLES / "pendant_pick.src"
@@ -374,8 +375,8 @@ def test_with_values_hold_for_their_motion_only() -> None:
     first, second = result.program.motions()
     assert (first.speed.linear, first.zone.radius) == (0.2, 0.003)
     assert (second.speed.linear, second.zone.radius) == (1.0, 0.0)
-    assert [n.span.line for n in result.notes] == [4]
-    assert "only" in result.notes[0].message
+    assert [n.span.line for n in own_notes(result.notes)] == [4]
+    assert "only" in own_notes(result.notes)[0].message
 
 
 def test_unknown_with_function_is_an_error() -> None:
@@ -604,7 +605,7 @@ def test_home_without_config_dat_is_a_motion_to_a_run_time_target() -> None:
     assert home.motion == "joint" and home.target == ir.Name(name="XHOME", span=home.target.span)
     assert "$config.dat" in home.reason and "--config-dat" in home.reason
     result = parse("PTP XHOMEX")
-    assert [n.message.split(" ")[0] for n in result.notes] == ["XHOMEX"]
+    assert [n.message.split(" ")[0] for n in own_notes(result.notes)] == ["XHOMEX"]
     error = parse_error("PTP XHOMEX", data=dat(), cfg=load_config_dat(CONFIG))
     assert "XHOMEX is not declared" in error.message
 

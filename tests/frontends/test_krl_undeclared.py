@@ -18,6 +18,7 @@ from olp.errors import ParseError
 from olp.frontends.bundled import KrlOptions
 from olp.frontends.krl import KrlData, KrlResult, load_config_dat, parse_dat, parse_krl
 from olp.ir_flow import leaves_and_blocks
+from tests.krl_notes import own_notes
 
 REPO = Path(__file__).resolve().parents[2]
 CONFIG = REPO / "examples" / "robot_config.dat"
@@ -60,7 +61,7 @@ def runtime(result: KrlResult) -> list[ir.RuntimeMove]:
 
 def warned(result: KrlResult) -> dict[str, tuple[int, int]]:
     """The name each note is about -> (line, column) of the note."""
-    return {n.message.split(" ")[0]: (n.span.line, n.span.column) for n in result.notes}
+    return {n.message.split(" ")[0]: (n.span.line, n.span.column) for n in own_notes(result.notes)}
 
 
 def test_a_point_of_a_missing_data_list_is_a_run_time_motion_with_one_warning_per_name() -> None:
@@ -72,7 +73,7 @@ def test_a_point_of_a_missing_data_list_is_a_run_time_motion_with_one_warning_pe
     assert "XSTACKBASE is not declared in t.src" in ptp.reason
     # once per name, at its first use: readyPos's is the assignment's target (line 9)
     assert warned(result) == {"readyPos": (9, 1), "xStackBase": (9, 12), "pOffset": (10, 27)}
-    first = result.notes[0].message
+    first = own_notes(result.notes)[0].message
     assert "no .dat file beside it; no $config.dat given" in first
     assert "cannot check what depends on it" in first
     assert "put t.dat beside the module / pass --config-dat to check these" in first
@@ -164,7 +165,7 @@ def test_a_misspelt_name_never_passes_silently(config: KrlData) -> None:
     for files in ({}, {"dat": empty_dat(), "config": config}):
         result = lower(*body, **files)  # type: ignore[arg-type]
         assert warned(result) == {"nCuont": (5, 4)}
-    assert "refuses a name nothing declares" in result.notes[0].message
+    assert "refuses a name nothing declares" in own_notes(result.notes)[0].message
 
 
 def test_a_function_nothing_declares_is_a_warning_and_kept_as_written() -> None:
@@ -185,7 +186,7 @@ def test_a_function_nothing_declares_is_a_warning_and_kept_as_written() -> None:
     )
     result = parse_krl(text, "t.src", dat=empty_dat())
     assert warned(result) == {"fnNextPart(...)": (5, 9)}
-    assert "another module" in result.notes[0].message
+    assert "another module" in own_notes(result.notes)[0].message
     (first, _second) = [n for n in nodes(result) if isinstance(n, ir.Assign)]
     assert first.value == ir.FunctionCall(
         name="fnNextPart",

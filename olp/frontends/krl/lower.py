@@ -153,6 +153,7 @@ class _Lowering(Motions, Events):
 
     def __init__(self, ctx: Context, state: State, variables: Variables) -> None:
         self.ambiguous: dict[str, str] = {}
+        self.unset: set[str] = set()  # tool/frame not set yet on some path (for a note)
         self._state = state
         super().__init__(ctx, state, variables)
         self.loops: list[str] = []  # the enclosing loops, innermost last: "block" or "unrolled"
@@ -205,6 +206,9 @@ class _Lowering(Motions, Events):
             old = self._state
             for name in [n for n in self.ambiguous if getattr(new, n) is not getattr(old, n)]:
                 del self.ambiguous[name]
+        if self.unset:
+            old = self._state
+            self.unset -= {n for n in self.unset if getattr(new, n) is not getattr(old, n)}
         self._state = new
 
     # ---- driving
@@ -803,6 +807,7 @@ class _Lowering(Motions, Events):
         child.loop_depth = self.loop_depth + (1 if loop else 0)
         child.loops = [*self.loops, "block"] if loop else list(self.loops)
         child.ambiguous = dict(self.ambiguous)
+        child.unset = set(self.unset)
         child.absorbed_data = dict(self.absorbed_data)
         child.routine = self.routine
         child.defining, child.generic = self.defining, self.generic
@@ -904,6 +909,7 @@ class _Lowering(Motions, Events):
         ambiguous: dict[str, str] = {}
         for e in ends:
             ambiguous.update(e.ambiguous)
+        unset = set().union(*(e.unset for e in ends))
         for name in _STATE_FIELDS:
             values = [getattr(s, name) for s in states]
             if any(v != values[0] for v in values[1:]):
@@ -911,6 +917,7 @@ class _Lowering(Motions, Events):
         vel_cp_set = all(s.vel_cp_set for s in states)
         self.state = dataclasses.replace(states[0], vel_cp_set=vel_cp_set)
         self.ambiguous = ambiguous
+        self.unset = unset
         tracks = [e.track for e in ends]
         if any(t != tracks[0] for t in tracks[1:]):
             self.track = dataclasses.replace(tracks[0])
@@ -1103,6 +1110,7 @@ def lower_module(
         started = _started_elsewhere(main, routines)
         if started is not None:
             lowering.track.lose(RuntimeStart(started))
+        lowering.unset = {"tool", "frame"}  # the controller's until the program sets them
         lowering.first_pass(main.body)
         lowering.lower_body(main.body)
         lowering.report_unwritten_settings()

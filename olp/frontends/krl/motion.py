@@ -131,6 +131,7 @@ class Motions(InlineForms):
             and self.exiting is None
             and getattr(self, "jumped", None) is None
             and not getattr(self, "ambiguous", None)
+            and not getattr(self, "unset", None)
             and self.ctx.remaining >= len(rows)
             and self._after_with is None
             and state.ori_type == "VAR"
@@ -154,6 +155,7 @@ class Motions(InlineForms):
         state, track = self.state, self.track
         if (
             self._after_with is not None
+            or getattr(self, "unset", None)  # the slow path notes it once
             or (base == "LIN" and state.ori_type != "VAR")
             or stmt.type_name is not None
             or not all(map(math.isfinite, stmt.values))
@@ -667,6 +669,7 @@ class Motions(InlineForms):
             self.out.append(Pending(make, target, via, fields))
 
     def _fields(self, stmt: MotionStmt, zone: ir.Zone) -> dict[str, Any]:
+        self._note_unset_frames(stmt)
         state = self.state
         return {
             "speed": state.speed,
@@ -676,6 +679,24 @@ class Motions(InlineForms):
             "span": stmt.span,
             **_spline(stmt.keyword),
         }
+
+    def _note_unset_frames(self, stmt: MotionStmt) -> None:
+        """A motion before the program sets its tool (base): olp checks it with the flange
+        (the world) and the output writes that before it, where the source ran with the one
+        the controller held when the module started (its caller's, the last program's). A
+        warning, once each (then the fast path may take the motions again)."""
+        unset: set[str] = getattr(self, "unset", set())
+        for name in sorted(unset):
+            setting, what, default = _UNSET_WORDS[name]
+            message = (
+                f"{stmt.keyword} before any {setting}: olp checks it with the {default} "
+                f"($NULLFRAME) as its {what}, and the output sets that {what} before it, while "
+                f"the source runs with the {what} the controller holds when the module starts "
+                f"(a caller's, the last program's): set {setting} (or use an inline form) "
+                "before the first motion if the module relies on another"
+            )
+            self._note(stmt.span, message, once=f"unset-{name}")
+        unset.clear()
 
     def _note_default_speed(self, stmt: MotionStmt) -> None:
         if not self.state.vel_cp_set:
@@ -942,6 +963,10 @@ class RuntimeStart(str):
 
 
 _MOTION_TEXT = re.compile(r"\s*(S?PTP|S?LIN|S?CIRC)(_REL)?\b", re.IGNORECASE)
+
+
+_UNSET_WORDS = {"tool": ("$TOOL", "tool", "flange"), "frame": ("$BASE", "base", "world")}
+"""A state field -> its KRL variable, its name and what olp takes before the program sets it."""
 
 
 def _spline(keyword: str) -> dict[str, bool]:

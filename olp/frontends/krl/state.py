@@ -938,6 +938,9 @@ class Core:
         ambiguous: dict[str, str] | None = getattr(self, "ambiguous", None)
         if ambiguous:
             ambiguous.pop(name, None)
+        unset: set[str] | None = getattr(self, "unset", None)
+        if unset:
+            unset.discard(name)
 
     def _reset_start(self, state: State, name: str, span: ir.SourceSpan) -> None:
         """A new tool or base: the start in its terms is unknown to olp. One the run already
