@@ -47,12 +47,21 @@ class Verbatim:
     ``reason`` (kind ``ignored``) instead of the error; passes treat it as absent. A statement
     that may change what olp models (a BAS with run-time values, ``$ACC.CP``) is never
     native-only: leaving it out would change what the robot does.
+
+    ``modelled`` (with ``native_only``): the statement sets motion settings that olp modelled
+    as the settings of a motion after it (a line of a FOR loop over ``$VEL_AXIS[i]`` that olp
+    unrolled into those settings). Any other post leaves it out without a word: it writes
+    that effect itself, with the motion. Its own post writes it, and writes every setting of
+    the next motion again after it (as after any verbatim statement): the motion then runs
+    with olp's values, the ones it checked, even where the statement's own differ in a way
+    olp's model does not hold (a percent per axis, where olp keeps the smallest).
     """
 
     text: str
     language: str
     reason: str = ""
     native_only: bool = False
+    modelled: bool = False
     span: SourceSpan = GENERATED
     kind: Literal["verbatim"] = field(default="verbatim", init=False)
 
@@ -64,6 +73,8 @@ class Verbatim:
             raise FlowError(f"Verbatim.text must be one line, found {bad!r} in {self.text!r}")
         if not self.language:
             raise FlowError("Verbatim.language must name the language of the text")
+        if self.modelled and not self.native_only:
+            raise FlowError("Verbatim.modelled needs native_only: its own post writes it")
 
 
 # --------------------------------------------------------------------------------------------

@@ -744,9 +744,12 @@ class Post:
         """A statement kept as source text goes out unchanged to its own language only; it was
         checked to be one line when made, so it cannot start another statement. One that
         matters only on its own language's controller (``native_only``) is left out of any
-        other with a warning giving its reason."""
+        other with a warning giving its reason; without one where this post writes what it
+        does as the settings of a motion (``modelled``)."""
         if ins.language == self.VERBATIM:
             return self._encoding_checks(step, "verbatim", ins.text)
+        if ins.modelled:
+            return []
         what = f"{ins.language.upper()} statement {_quote(ins.text)} (line {ins.span.line})"
         if ins.native_only:
             msg = f"{what} is not written: {ins.reason}"

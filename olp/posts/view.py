@@ -54,6 +54,9 @@ class ViewHooks(Protocol):
     @property
     def manifest(self) -> PostManifest: ...
 
+    @property
+    def VERBATIM(self) -> str | None: ...
+
     def step_values(self, robot: Any, joints: FloatArray) -> list[Mapping[str, Any]]: ...
 
     def step_columns(self, robot: Any, joints: FloatArray) -> Mapping[str, Any]: ...
@@ -537,7 +540,7 @@ class ProgramView:
             elif not isinstance(ins, MOTION_TYPES):
                 lines = self.post.comment_node_lines(ins) if ins.kind == "comment" else ()
                 out.append(PostStep(step.index, ins.kind, ins.span.location, ins, comment=lines))
-                if is_opaque(ins):
+                if is_opaque(ins, self.post.VERBATIM):
                     last.clear()  # the next motion sets everything again
             elif step.index in self.motions:
                 out.append(self._motion_step(step, names, last))
@@ -671,9 +674,13 @@ line olp does not model: either may set another tool, base, speed or zone): the 
 after one gets every ``new_*`` flag, so the post writes all its settings again."""
 
 
-def is_opaque(ins: Any) -> bool:
+def is_opaque(ins: Any, language: str | None = None) -> bool:
     """Whether ``ins`` may change the controller's motion settings (:data:`OPAQUE_KINDS`; a
-    verbatim statement marked ``native_only`` changes none of them)."""
+    verbatim statement marked ``native_only`` changes none of them, unless it is ``modelled``
+    and written here, by the post of its ``language``: it sets settings on the controller,
+    which the next motion then writes again with olp's values)."""
+    if getattr(ins, "modelled", False):
+        return ins.language == language
     return ins.kind in OPAQUE_KINDS and not getattr(ins, "native_only", False)
 
 

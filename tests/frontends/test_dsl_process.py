@@ -396,7 +396,7 @@ session().record(forged(ir.{cls}, span=ir.SourceSpan("prog.py", 14, 1), {fields}
         (
             "Verbatim",
             "text='WAIT SEC 1\\nLIN {X 0,Y 0,Z 0,A 0,B 0,C 0}', language='krl', reason='', "
-            "native_only=False, kind='verbatim'",
+            "native_only=False, modelled=False, kind='verbatim'",
             "must be one line",
         ),
         ("Wait", "seconds=-5.0, kind='wait'", "Wait"),

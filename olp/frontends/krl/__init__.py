@@ -86,7 +86,12 @@ What is lowered
   motions builds.
 * **Unrolled FOR loops** write ``counter = n`` before a pass whose output reads the counter
   (a run-time motion such as ``LIN xPath[i]``, a statement kept as written such as
-  ``r[i] = $OV_PRO``, ``Foo(i)``).
+  ``r[i] = $OV_PRO``, ``Foo(i)``). One whose body only sets motion settings olp models
+  (``FOR ax = 1 TO 6 $VEL_AXIS[ax] = 20 ENDFOR``) is unrolled into the settings and kept as
+  written where it stands, as KRL-only lines: the KUKA post writes the loop, then the next
+  motion's settings again (olp's values); other posts write those settings with the motion,
+  and leave the loop out without a warning where a motion olp models follows it
+  (:attr:`olp.ir.Verbatim.modelled`), with one where none does.
 * **Speeds.** ``$VEL.CP`` (m/s) -> ``Speed.linear``; ``$VEL_AXIS[i]``/``$ACC_AXIS[i]`` (%) ->
   ``Speed.joint``/``joint_acceleration`` as the **minimum** over the axes set so far (one
   fraction cannot hold per-axis values; the slowest axis bounds a synchronised PTP).

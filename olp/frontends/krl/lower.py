@@ -3,7 +3,8 @@
 See :mod:`olp.frontends.krl` for what is lowered and the decisions behind it. In short: the first
 DEF is the program; calls of other DEFs of the module are lowered at each call and kept as
 calls of routines (:mod:`olp.frontends.krl.routines`); FOR loops with constant
-bounds are unrolled; straight-line statements are lowered; other control flow is ignored when
+bounds are unrolled (one that only sets motion settings is kept as written too, for the KRL
+post); straight-line statements are lowered; other control flow is ignored when
 lowering it would change nothing, and rejected (naming the construct and its line) otherwise.
 """
 
@@ -167,6 +168,9 @@ class _Lowering(Motions, Events):
         # statements that set motion settings (absorbed into the motions) since the last motion
         self.unwritten: list[Stmt] = []
         self.unwritten_at: list[tuple[list[Any], int]] = []  # each one's output list, position
+        self.reports = 0  # lines reported as left out by this lowering (once each or not)
+        # FOR loops kept as written since the last motion: output list, first and end position
+        self.settings_loops: list[tuple[list[Any], int, int]] = []
         self.live_outs: list[list[Any]] = []  # the output lists this lowering is nested in
         self.folds: list[str] = []  # the titles of the source's folds open here, innermost last
         self._blocks: dict[str, Callable[[Block], None]] = {
@@ -319,9 +323,35 @@ class _Lowering(Motions, Events):
         if moves(new) or any(isinstance(n, Pending | PendingRows) for n in leaves(new)):
             self.unwritten.clear()
             self.unwritten_at.clear()
+            self._settings_loops_modelled()
         elif isinstance(stmt, Assign | CallStmt) and not new and not reported:
             self.unwritten.append(stmt)
             self.unwritten_at.append((self.out, len(self.out)))
+
+    def _ignore(self, stmt: Stmt | Assign, reason: str) -> None:
+        """Report ``stmt`` as left out (once per line and reason), and count the report even
+        where it was made before (a loop lowered again: :meth:`_unroll_settings`)."""
+        self.reports += 1
+        super()._ignore(stmt, reason)
+
+    def _settings_loops_modelled(self) -> None:
+        """A motion olp models runs with what the FOR loops kept since the last motion set
+        (:meth:`_keep_settings_loop`): their lines become ``modelled`` where they still stand
+        in an output list being built (one in a block already lowered keeps its warning)."""
+        live = [*self.live_outs, self.out]
+        for out, first, last in self.settings_loops:
+            if any(out is candidate for candidate in live):
+                for k in range(first, last):
+                    if isinstance(out[k], ir.Verbatim):
+                        out[k] = dataclasses.replace(out[k], modelled=True)
+        self.settings_loops.clear()
+
+    def _keep_unwritten(self, reason: str, strict: bool = True) -> None:
+        """What comes next runs with the controller's settings: the FOR loops kept since the
+        last motion keep their lines' warning for other posts (see
+        :meth:`_keep_settings_loop`); the statements olp absorbed are kept as written."""
+        self.settings_loops.clear()
+        super()._keep_unwritten(reason, strict)
 
     def report_unwritten_settings(self) -> None:
         """The settings no motion of the program follows (a routine that sets ``$BASE`` and
@@ -644,13 +674,83 @@ class _Lowering(Motions, Events):
         elif self._lowers_as_block(stmt, counts[0]):
             self._for_block(stmt)
             return
+        elif self._sets_settings_only(stmt):
+            self._unroll_settings(stmt, counts)
+            return
         else:
-            self._ignore(
-                stmt,
-                f"the FOR loop is written out {len(counts)} times: what it does depends on "
-                f"{stmt.counter}, which olp knows only by unrolling it",
-            )
+            self._written_out(stmt, len(counts))
         self._unroll(stmt, counts)
+
+    def _written_out(self, stmt: ForLoop, count: int) -> None:
+        self._ignore(
+            stmt,
+            f"the FOR loop is written out {count} times: what it does depends on "
+            f"{stmt.counter}, which olp knows only by unrolling it",
+        )
+
+    def _sets_settings_only(self, stmt: ForLoop) -> bool:
+        """Whether the body of ``stmt`` only assigns motion settings olp models (``$VEL_AXIS[i]
+        = 20``, ``$ACC_AXIS[i]``; comments apart) and its source lines are at hand."""
+        if self.sources.source(stmt.span.file) is None or stmt.span.end_line is None:
+            return False
+        return all(
+            isinstance(s, CommentStmt) or (isinstance(s, Assign) and s.target.key in self._setters)
+            for s in stmt.body
+        )
+
+    def _unroll_settings(self, stmt: ForLoop, counts: range) -> None:
+        """A FOR loop that only sets motion settings (``FOR i = 1 TO 6 $VEL_AXIS[i] = 20
+        ENDFOR``): unrolled into the motion settings, so that the motions after it are checked
+        and timed with what each pass sets, and kept as written line by line (its comments as
+        comments) where it stands, for the KRL post (:meth:`_keep_settings_loop`). Where a pass
+        leaves anything in the program or reports a line (a setting olp keeps as written, an
+        output), the loop is written out pass by pass instead, with a warning."""
+        start, reported, tracked = len(self.out), self.reports, len(self.unwritten)
+        self._unroll(stmt, counts)
+        passes = self.out[start:]
+        if self.reports > reported or not all(isinstance(n, ir.Comment) for n in passes):
+            self._written_out(stmt, len(counts))
+            return
+        del self.out[start:]  # the comments of every pass: the loop's own lines replace them
+        # the loop's lines stand where it does: its settings are never left unwritten
+        del self.unwritten[tracked:]
+        del self.unwritten_at[tracked:]
+        self._keep_settings_loop(stmt)
+
+    def _keep_settings_loop(self, stmt: ForLoop) -> None:
+        """The lines of a FOR loop that only sets motion settings, as written: each statement
+        a KRL-only :class:`~olp.ir.Verbatim` (other posts write what it sets as the settings of
+        the motions olp models after it), each comment an :class:`~olp.ir.Comment`. The lines
+        become ``modelled`` (left out of other posts without a warning) when a motion olp models
+        follows them (:meth:`_track_settings`); until then other posts leave them out with a
+        warning."""
+        assert stmt.span.end_line is not None
+        reason = (
+            f"a line of the FOR loop at line {stmt.span.line}, which sets motion settings: "
+            "written for KUKA controllers only; another post writes what it sets only as the "
+            "settings of the motions olp models after it"
+        )
+        first = len(self.out)
+        self._keep_line(stmt.span.line, stmt.span.file, reason)
+        for inner in stmt.body:
+            if isinstance(inner, CommentStmt):
+                self.out.append(
+                    ir.Comment(text=inner.text, span=inner.span, fold=inner.fold, from_source=True)
+                )
+            else:
+                self._keep_text(code_of(self.sources.snippet(inner.span)), inner.span, reason, True)
+        self._keep_line(stmt.span.end_line, stmt.span.file, reason)
+        self.settings_loops.append((self.out, first, len(self.out)))
+
+    def _keep_line(self, number: int, file: str, reason: str) -> None:
+        """The statement on line ``number`` of ``file`` as written (its comment apart), as a
+        KRL-only :class:`~olp.ir.Verbatim`: the head or end of a kept FOR loop."""
+        source = self.sources.source(file)
+        line = (source.line(number) if source is not None else None) or ""
+        code = code_of(line)
+        column = line.index(code) + 1
+        span = ir.SourceSpan(file, number, column, number, column + len(code))
+        self._keep_text(code, span, reason, krl_only=True)
 
     def _lowers_as_block(self, stmt: ForLoop, first: int) -> bool:
         """Whether the body lowers with the counter unknown (then the loop stays a loop): with
@@ -824,6 +924,7 @@ class _Lowering(Motions, Events):
             )
             child._reported = self._reported
             child.unwritten, child.unwritten_at = self.unwritten, self.unwritten_at
+            child.settings_loops = self.settings_loops
         return child
 
     def _branch(self, body: Sequence[Stmt], loop: bool = False) -> tuple[_Lowering, Body]:
