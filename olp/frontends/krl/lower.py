@@ -420,6 +420,16 @@ class _Lowering(Motions, Events):
         else:
             self._unread_call(stmt)
 
+    def _entered(self, routine: Routine, what: str) -> None:
+        """Start ``routine`` (one no call of the program reaches; ``what``: how it runs) from
+        what olp knows where an unknown caller enters it: what it knows after a call of a
+        routine it did not read (:meth:`_unread_call`): every motion setting held by the
+        controller, the robot where olp does not know."""
+        why = Held(f"{routine.name} {what}: its caller's motion settings are the controller's")
+        for name in _STATE_FIELDS:
+            self.ambiguous[name] = why
+        self.track.lose(RuntimeStart(f"{routine.name} {what}: it starts where its caller is"))
+
     def _unread_call(self, stmt: CallStmt) -> None:
         """A call of a routine olp did not read (another module's, an ``EXT`` one): it may set
         any motion setting (a ``MoveSettings(nBase, nTool)``) and may move the robot. So the
@@ -1084,6 +1094,7 @@ def lower_module(
     table = {r.name.upper(): r for r in ordered}
     ctx = Context(sources, table, src, dat, config, MAX_LOWERED_STATEMENTS, shared)
     ctx.calls_keep_settings = calls_keep_settings
+    entry = dict(values)  # the program's lowering changes ``values``
     lowering = _Lowering(ctx, State(), _variables(values, ctx, main))
     if main is not None:
         if main.kind == "DEFFCT":  # its RETURN value gives the result: kept, as a function's
@@ -1096,7 +1107,7 @@ def lower_module(
         lowering.first_pass(main.body)
         lowering.lower_body(main.body)
         lowering.report_unwritten_settings()
-    alone = _lower_alone(ordered[1:] if main is not None else ordered, lowering, values)
+    alone = _lower_alone(ordered[1:] if main is not None else ordered, lowering, entry, routines)
     body = build_instructions(lowering.out)
     assembled = assemble(body, alone, {k: v for k, v in table.items() if v is not main}, sources)
     ignored = sorted(
@@ -1188,18 +1199,35 @@ def _returns_dims(main: Routine) -> tuple[ir.Expr | None, ...]:
 
 
 def _lower_alone(
-    routines: Sequence[Routine], main: _Lowering, values: Any
+    routines: Sequence[Routine],
+    main: _Lowering,
+    values: dict[str, Value],
+    module: Sequence[Routine],
 ) -> dict[str, tuple[ir.Node, ...]]:
     """The routines no call of the program reaches (interrupt handlers, functions, routines
-    never called), each lowered on its own: upper-case name -> body. One that olp cannot
-    lower, or that moves the robot (where it runs from is unknown, so its motions could not
-    be checked), is reported and left out."""
+    never called: a library's, which other modules or the PLC call), each lowered on its own:
+    upper-case name -> body. ``values``: the module's variables before the program ran;
+    ``module``: all of its routines.
+
+    Such a routine is entered from a context olp does not know, so it is lowered from exactly
+    the state olp has after a call of a routine it did not read (:meth:`_Lowering._entered`):
+    every motion setting held by the controller, the robot where olp does not know, the
+    module's variables known only where nothing assigns them. A plain motion in it then runs
+    with the controller's settings (:meth:`_Lowering._controller_settings_motion`); one whose
+    settings the routine sets itself (an inline form) is modelled: its target checked, its
+    path not (it starts where the caller left the robot). A note on the routine's head says so.
+    One that olp cannot lower is reported and left out."""
     ctx = main.ctx
     bodies: dict[str, tuple[ir.Node, ...]] = {}
+    entry = _entry_values(values, module)
     for routine in routines:
         if routine.name.upper() in ctx.called:
             continue
-        lowering = _Lowering(ctx, State(), Variables(values, ctx.unknown_name))
+        runs_as = ctx.handlers.get(routine.name.upper())
+        what = f"runs from the {runs_as}" if runs_as is not None else "is never called"
+        if routine.kind == "DEFFCT":
+            what = "is a function the program does not call" if runs_as is None else what
+        lowering = _Lowering(ctx, State(), Variables(dict(entry), ctx.unknown_name))
         lowering.variables.push(
             {
                 p.name.upper(): Unknown(f"{p.name} is a parameter of {routine.name}")
@@ -1210,6 +1238,7 @@ def _lower_alone(
         lowering.ignored, lowering.notes = main.ignored, main.notes
         lowering.status_turn, lowering._reported = main.status_turn, main._reported
         lowering.routine = RoutineJumps.of(routine.body)
+        lowering._entered(routine, what)
         reason = None
         try:
             lowering.first_pass(routine.body)
@@ -1218,18 +1247,18 @@ def _lower_alone(
             body = build_instructions(lowering.out)
         except ParseError as exc:
             reason = f"olp cannot lower it: {exc.message}"
-        else:
-            if moves(body):
-                reason = (
-                    "it moves the robot, and olp checks motions only where the program calls them"
-                )
         if reason is None:
             bodies[routine.name.upper()] = body
+            if moves(body):
+                main._note(
+                    routine.span,
+                    f"{routine.kind} {routine.name} {what} in this module: written, and checked "
+                    "only as far as an unknown caller allows (it starts with the controller's "
+                    "motion settings and where the caller left the robot: its plain motions run "
+                    "with the controller's settings, its inline forms' targets are checked, "
+                    "their paths from the start are not)",
+                )
             continue
-        runs_as = ctx.handlers.get(routine.name.upper())
-        what = f"runs from the {runs_as}" if runs_as is not None else "is never called"
-        if routine.kind == "DEFFCT":
-            what = "is a function the program does not call" if runs_as is None else what
         main.ignored.append(
             IgnoredLine(
                 routine.span,
@@ -1238,6 +1267,28 @@ def _lower_alone(
             )
         )
     return bodies
+
+
+def _entry_values(values: dict[str, Value], module: Sequence[Routine]) -> dict[str, Value]:
+    """The module's variables where a routine no call of the program reaches is entered:
+    their declared (data-list) values where nothing in the module assigns them, else known only
+    when the program runs (another routine, an earlier run of this one, or a routine olp did
+    not read given it by reference may have changed it)."""
+    assigned: set[str] = set()
+    for routine in module:
+        assigned |= assigned_names(routine.body)
+        for stmt in statements(routine.body):
+            if isinstance(stmt, CallStmt):  # KRL passes a plain variable by reference
+                assigned |= {a.name.upper() for a in stmt.args if isinstance(a, Var)}
+    return {
+        name: Unknown(
+            f"{name} is assigned in the module: where a routine no call of the program reaches "
+            "starts, its value is known only when the program runs"
+        )
+        if name in assigned
+        else value
+        for name, value in values.items()
+    }
 
 
 def _routines(module: Module, sources: SourceSet, src: str) -> list[Routine]:

@@ -17,10 +17,12 @@ and wraps what it lowered in a :class:`PendingCall`. :func:`assemble` then decid
   routine is written out at each call, as olp did before it kept routines, with a warning that
   names the first statement that differs and two calls that differ there.
 
-Routines no call reaches (interrupt handlers, functions, routines never called) are lowered
-once on their own (parameters unknown, motion settings the controller's defaults) by
-:mod:`olp.frontends.krl.lower` and kept when they do not move the robot: where such a routine
-runs from, olp cannot know, so a motion in it could not be checked.
+Routines no call reaches (interrupt handlers, functions, a library's routines that other
+modules or the PLC call) are lowered once on their own by :mod:`olp.frontends.krl.lower`, from
+what olp knows where an unknown caller enters them (parameters unknown, every motion setting
+the controller's, the robot where olp does not know): a plain motion in one runs with the
+controller's settings, an inline form's is modelled; the checks take such a routine from an
+unknown start (:attr:`olp.ir_flow.Expanded.entry`).
 """
 
 from __future__ import annotations
