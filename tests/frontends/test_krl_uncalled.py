@@ -10,6 +10,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 import olp
 from olp import ir
 
@@ -111,15 +113,18 @@ def test_rapid_refuses_the_motion_with_the_controller_s_settings(tmp_path: Path)
     assert refused[0].hint
 
 
-def test_a_variable_the_module_assigns_is_known_only_at_run_time_there(tmp_path: Path) -> None:
-    """The program assigns XP1: where an unknown caller enters PutDown, XP1 may hold that or
-    anything another routine left, so the PTP to it is a run-time motion, not one checked with
-    the data list's value."""
-    main = MAIN.replace("END", "XP1.Z = 650\nEND")
-    result = _build(tmp_path, main + PUT_DOWN.replace("\n", "\n", 1))
+@pytest.mark.parametrize("change", ["XP1.Z = 650", "Measure(XP1)"])
+def test_a_variable_the_module_changes_is_known_only_at_run_time_there(
+    tmp_path: Path, change: str
+) -> None:
+    """The program assigns XP1, or gives it to a routine olp did not read (by reference):
+    where an unknown caller enters PutDown, XP1 may hold that or anything another routine left,
+    so the PTP to it is a run-time motion, not one checked with the data list's value."""
+    main = MAIN.replace("END", f"{change}\nEND")
+    result = _build(tmp_path, main + PUT_DOWN)
     assert result.ok, [d.format() for d in result.diagnostics]
     ptp = next(n for n in _routine(result, "PutDown").body if n.span.line == 11)
-    assert isinstance(ptp, ir.RuntimeMove)
+    assert isinstance(ptp, ir.RuntimeMove) and "XP1 is assigned in the module" in ptp.reason
 
 
 def test_an_interrupt_routine_that_moves_relative_to_where_it_stops_is_written(
@@ -145,3 +150,34 @@ def test_an_interrupt_routine_that_moves_relative_to_where_it_stops_is_written(
     lines = [line.strip() for line in result.files["cell.src"].splitlines()]
     head = lines.index("DEF BackOff()")
     assert lines[head + 1 : head + 5] == ["BRAKE F", "LIN_REL {Z 20}", "RESUME", "END"]
+
+
+def test_a_routine_each_call_runs_with_the_controller_s_settings_is_one_routine(
+    tmp_path: Path,
+) -> None:
+    """Each call follows a call of a routine olp did not read: the plain LIN in Place runs
+    with the controller's settings at both, for reasons that name another line; one text holds
+    both (it was written out at each call with a warning)."""
+    text = (
+        "DEF cell( )\n"
+        "EXT Pattern(INT:IN)\n"
+        "PTP {A1 0, A2 -90, A3 90, A4 0, A5 45, A6 0}\n"
+        "Pattern(1)\n"
+        "Place( )\n"  # 5
+        "Pattern(2)\n"
+        "Place( )\n"  # 7
+        "END\n"
+        "DEF Place( )\n"
+        "LIN {X 500, Y 0, Z 600, A 0, B 90, C 0}\n"  # 10
+        "END\n"
+    )
+    result = _build(tmp_path, text)
+    assert result.ok, [d.format() for d in result.diagnostics]
+    assert not [d for d in result.diagnostics if d.kind == "ignored"]
+    calls = [n for n in result.compiled.program.instructions if isinstance(n, ir.Expanded)]
+    assert [c.span.line for c in calls] == [5, 7]
+    (lin,) = _routine(result, "Place").body
+    assert isinstance(lin, ir.RuntimeMove) and lin.controller_settings
+    assert "at each of its calls (lines 5, 7)" in lin.reason
+    lines = [line.strip() for line in result.files["cell.src"].splitlines()]
+    assert lines.count("Place()") == 2 and lines.count("DEF Place()") == 1
