@@ -835,14 +835,19 @@ def expand_entries(nodes: Sequence[Any], routines: Sequence[Routine]) -> tuple[A
     order; its own calls of other routines expanded."""
     table = {r.name.casefold(): r for r in routines}
     out = list(nodes)
+    ran = _expanded_names(out)
     for routine in routines:
-        ran = {n.call.name.casefold() for n in leaves_and_blocks(out) if isinstance(n, Expanded)}
         if routine.name.casefold() in ran or not _has_motion(routine.body):
             continue
         call = RoutineCall(name=routine.name, span=routine.span)
         body = _expand(routine.body, table, (routine.name.casefold(),))
         out.append(Expanded(call=call, body=body, span=routine.span, entry=True))
+        ran |= {routine.name.casefold(), *_expanded_names(body)}
     return tuple(out)
+
+
+def _expanded_names(nodes: Sequence[Any]) -> set[str]:
+    return {n.call.name.casefold() for n in leaves_and_blocks(nodes) if isinstance(n, Expanded)}
 
 
 def _has_motion(nodes: Sequence[Any]) -> bool:

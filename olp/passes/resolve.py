@@ -127,7 +127,7 @@ def resolve(
     items: list[Item] = []
     diags: list[Diagnostic] = []
     nodes = program.flat_nodes()  # control flow: each instruction once, in source order
-    entries = _entry_starts(program)
+    entries = _entry_starts(program, len(nodes))
     index = flat = 0
     while index < len(nodes):
         node = nodes[index]
@@ -322,14 +322,20 @@ def _lookup_errors(
     return out
 
 
-def _entry_starts(program: Program) -> dict[int, Expanded]:
-    """The index in :meth:`~olp.ir.Program.flat_nodes` of the first node of each entry
-    (:attr:`olp.ir_flow.Expanded.entry`: a routine no call runs, after the program's end)."""
+def _entry_starts(program: Program, total: int) -> dict[int, Expanded]:
+    """The index in :meth:`~olp.ir.Program.flat_nodes` (``total`` of them) of the first node
+    of each entry (:attr:`olp.ir_flow.Expanded.entry`: a routine no call runs, expanded after
+    the program's end)."""
+    entries: list[Expanded] = []
+    for node in reversed(program.instructions):
+        if not (isinstance(node, Expanded) and node.entry):
+            break
+        entries.insert(0, node)
+    counts = [sum(1 for _ in leaves([node])) for node in entries]
+    at = total - sum(counts)
     out: dict[int, Expanded] = {}
-    at = 0
-    for node in program.instructions:
-        count = sum(1 for _ in leaves([node]))
-        if isinstance(node, Expanded) and node.entry and count:
+    for node, count in zip(entries, counts, strict=True):
+        if count:
             out[at] = node
         at += count
     return out
