@@ -983,12 +983,15 @@ class Program:
     def expanded(self) -> Program:
         """The analysis view: every :class:`RoutineCall` of one of the program's routines made
         an :class:`Expanded` holding the routine's body (:func:`olp.ir_flow.expand_calls`), so
-        that iterating the program yields every instruction of a routine at each call site.
+        that iterating the program yields every instruction of a routine at each call site;
+        a routine that moves the robot and that no call runs is expanded after the program's
+        end as an entry (:attr:`olp.ir_flow.Expanded.entry`), checked from an unknown caller.
         The routines are kept (a post writes them from here). Returns the program itself when
         it holds no routine. Raises :class:`olp.ir_flow.FlowError` for recursion."""
         if not self.routines:
             return self
         nodes = _flow.expand_calls(self.instructions, self.routines)
+        nodes = _flow.expand_entries(nodes, self.routines)
         return dataclasses.replace(self, instructions=nodes)
 
     def __iter__(self) -> Iterator[Instruction]:

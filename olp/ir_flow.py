@@ -544,11 +544,18 @@ class Expanded:
     inside a routine has a step of its own at every call site; the call itself is not an
     instruction there (a post writes it as the call). A :class:`Return` in ``body`` ends the
     expansion, and its labels are its own (a label in a routine is not one of the caller's).
+
+    ``entry``: not a call but a routine no call of the program runs (a library's, called from
+    other modules or the PLC) that moves the robot, expanded after the program's end
+    (:func:`expand_entries`) so that its motions are checked from where an unknown caller
+    enters it: the robot where olp does not know. It is no part of the program's run: no
+    predecessor of its motions, no part of the cycle time, not written as a call.
     """
 
     call: RoutineCall
     body: tuple[Node, ...]
     span: SourceSpan = GENERATED
+    entry: bool = False
     kind: Literal["expanded"] = field(default="expanded", init=False)
 
     def __post_init__(self) -> None:
@@ -841,12 +848,43 @@ def _expand(
     return tuple(out)
 
 
+def expand_entries(nodes: Sequence[Any], routines: Sequence[Routine]) -> tuple[Any, ...]:
+    """``nodes`` (calls already expanded, :func:`expand_calls`) with an entry
+    (:attr:`Expanded.entry`) appended for each routine of ``routines`` that no expansion in
+    ``nodes`` (nor an earlier entry) runs and whose body holds a motion, in the routines'
+    order; its own calls of other routines expanded."""
+    table = {r.name.casefold(): r for r in routines}
+    out = list(nodes)
+    ran = _expanded_names(out)
+    for routine in routines:
+        if routine.name.casefold() in ran or not _has_motion(routine.body):
+            continue
+        call = RoutineCall(name=routine.name, span=routine.span)
+        body = _expand(routine.body, table, (routine.name.casefold(),))
+        out.append(Expanded(call=call, body=body, span=routine.span, entry=True))
+        ran |= {routine.name.casefold(), *_expanded_names(body)}
+    return tuple(out)
+
+
+def _expanded_names(nodes: Sequence[Any]) -> set[str]:
+    return {n.call.name.casefold() for n in leaves_and_blocks(nodes) if isinstance(n, Expanded)}
+
+
+def _has_motion(nodes: Sequence[Any]) -> bool:
+    from olp.ir import LinearPath, RuntimeMove, is_motion  # (olp.ir builds on this module)
+
+    return any(is_motion(n) or isinstance(n, RuntimeMove | LinearPath) for n in leaves(nodes))
+
+
 def inline_expansions(nodes: Sequence[Any]) -> tuple[Any, ...]:
     """``nodes`` with every :class:`Expanded` replaced by its body, in place: one body without
     routines, for a writer that does not write them. Instructions keep their order (the step
-    of each stays its step)."""
+    of each stays its step). An entry (:attr:`Expanded.entry`) is no part of the program's
+    run: left out."""
     out: list[Any] = []
     for node in nodes:
+        if isinstance(node, Expanded) and node.entry:
+            continue
         if isinstance(node, Expanded):
             out.extend(inline_expansions(node.body))
         elif isinstance(node, BLOCK_TYPES):

@@ -118,7 +118,13 @@ def test_a_call_of_another_modules_routine_is_not_expanded() -> None:
     prog = ir.Program(name="p", instructions=[ir.RoutineCall(name="Elsewhere")], routines=[])
     assert prog.expanded() is prog
     other = dataclasses.replace(program(), instructions=(ir.RoutineCall(name="Elsewhere"),))
-    assert [n.kind for n in other.expanded()] == ["routine_call"]
+    expanded = other.expanded().instructions
+    assert [n.kind for n in expanded] == ["routine_call", "expanded"]
+    # Place moves the robot and no call runs it: an entry after the program's end (checked
+    # from an unknown caller), Grip runs inside it, Full does not move
+    entry = expanded[1]
+    assert isinstance(entry, ir.Expanded) and entry.entry and entry.call.name == "Place"
+    assert ir.inline_expansions(expanded) == expanded[:1]  # no part of the program's run
 
 
 def test_editing_motions_reaches_the_routines() -> None:

@@ -28,6 +28,9 @@ from olp.ir_flow import BLOCK_TYPES, leaves_and_blocks
 
 START = -1
 """The predecessor that stands for the start of the program (the robot where it stands)."""
+ENTRY = -2
+"""The predecessor that stands for an unknown caller of a routine no call of the program runs
+(:attr:`olp.ir_flow.Expanded.entry`): resolve checks its first motion from an unknown start."""
 MAX_ROUNDS = 64
 """Rounds of the whole-program walk (jumps need several); the sets only grow, so it ends."""
 
@@ -57,6 +60,9 @@ class _Walk:
         if isinstance(node, ir.Switch):
             ends = [self.body(c.body, state) for c in node.cases]
             return frozenset().union(*ends, self.body(node.default, state))
+        if isinstance(node, ir.Expanded) and node.entry:  # no part of the program's run
+            self.expanded(node, frozenset({ENTRY}))
+            return state
         if isinstance(node, ir.Expanded):
             return self.expanded(node, state)
         if isinstance(node, BLOCK_TYPES):
@@ -179,7 +185,7 @@ def flow_pass(compiled: CompiledProgram, options: Any) -> CompiledProgram:
     found: list[Diagnostic] = []
     others = 0
     for index, before in sorted(preds.items()):
-        extra = sorted(before - {textual[index]})
+        extra = sorted(before - {textual[index], ENTRY})
         instruction = compiled.steps[index].instruction
         if not extra or isinstance(instruction, ir.JointMove):
             continue

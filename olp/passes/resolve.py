@@ -47,6 +47,7 @@ from olp.ir import (
     CartesianTarget,
     CircularMove,
     Configuration,
+    Expanded,
     Frame,
     Instruction,
     JointMove,
@@ -59,6 +60,7 @@ from olp.ir import (
     SourceSpan,
     Tool,
 )
+from olp.ir_flow import leaves
 from olp.kinematics.base import turn_variants
 from olp.kinematics.singularity import ON_SINGULARITY, meeting_branches, singularity_distances
 from olp.passes import wording
@@ -125,9 +127,12 @@ def resolve(
     items: list[Item] = []
     diags: list[Diagnostic] = []
     nodes = program.flat_nodes()  # control flow: each instruction once, in source order
+    entries = _entry_starts(program, len(nodes))
     index = flat = 0
     while index < len(nodes):
         node = nodes[index]
+        if index in entries:  # a routine no call runs: its caller leaves the robot anywhere
+            state.unknown_start, state.q = entries[index], start_joints.copy()
         if isinstance(node, RuntimeMove) or (
             state.unknown_start is not None and isinstance(node, MOTION_TYPES)
         ):
@@ -164,7 +169,8 @@ def resolve(
             index, flat = index + 1, flat + len(node)
             progress.advance(len(node))
             continue
-        run = _linear_run(nodes, index, flat, station)
+        stop = next((k for k in entries if k > index), len(nodes))
+        run = _linear_run(nodes, index, flat, station, stop)
         if run:
             found_items, found = _resolve_linear_run(run, station, state)
             items.extend(found_items)
@@ -273,7 +279,12 @@ def _after_unknown_start(
         return Step(index=index, instruction=ins, tool=tool, frame=frame), found
     state.q = path[-1].copy()
     kind = _MOVE_WORDS[ins.kind]
-    if isinstance(runtime, Call):
+    if isinstance(runtime, Expanded):
+        where = (
+            f"the unknown caller of {runtime.call.name} (line {runtime.span.line}, a routine no "
+            "call of the program runs) leaves the robot"
+        )
+    elif isinstance(runtime, Call):
         where = (
             f"the call of {runtime.name} at line {runtime.span.line} leaves the robot (a routine "
             "olp did not read, which may move it)"
@@ -311,6 +322,25 @@ def _lookup_errors(
     return out
 
 
+def _entry_starts(program: Program, total: int) -> dict[int, Expanded]:
+    """The index in :meth:`~olp.ir.Program.flat_nodes` (``total`` of them) of the first node
+    of each entry (:attr:`olp.ir_flow.Expanded.entry`: a routine no call runs, expanded after
+    the program's end)."""
+    entries: list[Expanded] = []
+    for node in reversed(program.instructions):
+        if not (isinstance(node, Expanded) and node.entry):
+            break
+        entries.insert(0, node)
+    counts = [sum(1 for _ in leaves([node])) for node in entries]
+    at = total - sum(counts)
+    out: dict[int, Expanded] = {}
+    for node, count in zip(entries, counts, strict=True):
+        if count:
+            out[at] = node
+        at += count
+    return out
+
+
 def _node_of(item: Item) -> Node:
     return item.node if isinstance(item, PathBlock) else item.instruction
 
@@ -325,7 +355,7 @@ class _State:
     q: FloatArray
     robot: Robot
     opts: ResolveOptions
-    unknown_start: RuntimeMove | Call | None = None
+    unknown_start: RuntimeMove | Call | Expanded | None = None
 
 
 def _error(kind: str, message: str, index: int, ins: Instruction, **kw: object) -> Diagnostic:
@@ -396,9 +426,12 @@ class _Run:
         )
 
 
-def _linear_run(nodes: tuple[Node, ...], start: int, first: int, station: Station) -> _Run | None:
+def _linear_run(
+    nodes: tuple[Node, ...], start: int, first: int, station: Station, stop: int
+) -> _Run | None:
     """The consecutive linear moves from node ``start`` (instruction ``first``) to Cartesian
-    targets with one resolvable tool and resolvable frames (None if none start here).
+    targets with one resolvable tool and resolvable frames, before node ``stop`` (an entry's
+    start), None if none start here.
 
     Walks the nodes by index: a slice ``nodes[start:]`` would copy the rest of the program for
     every instruction that starts no run, which made resolve quadratic in non-motion
@@ -406,7 +439,7 @@ def _linear_run(nodes: tuple[Node, ...], start: int, first: int, station: Statio
     moves: list[LinearMove] = []
     frames: list[Frame] = []
     first_tool: Tool | None = None
-    for index in range(start, len(nodes)):
+    for index in range(start, stop):
         ins = nodes[index]
         if not (isinstance(ins, LinearMove) and isinstance(ins.target, CartesianTarget)):
             break

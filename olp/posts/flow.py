@@ -154,7 +154,8 @@ class _Weaver:
     def nodes(self, nodes: Sequence[Any]) -> Iterator[PostStep]:
         for node in nodes:
             if isinstance(node, ir.Expanded):
-                yield _marker("routine_call", node.call, node.span)
+                if not node.entry:  # an entry is no call: its routine is written on its own
+                    yield _marker("routine_call", node.call, node.span)
                 self.cursor += sum(
                     len(n) if isinstance(n, ir.LinearPath) else 1 for n in leaves(node.body)
                 )

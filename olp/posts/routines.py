@@ -40,7 +40,8 @@ def written_out(compiled: CompiledProgram, post: Post) -> tuple[CompiledProgram,
     sites = expansions(program)
     found: list[Diagnostic] = []
     for routine in program.routines:
-        found += _written_out_problems(routine, routine.name.upper() in sites, post)
+        called = any(not node.entry for node, _ in sites.get(routine.name.upper(), []))
+        found += _written_out_problems(routine, called, post)
     found += _shared_names(program, sites, post)
     nodes = inline_expansions(program.instructions)
     flat = dataclasses.replace(program, instructions=nodes, routines=())

@@ -376,10 +376,10 @@ def test_unlowered_statements_are_listed_with_their_lines() -> None:
 def test_other_routines_are_listed() -> None:
     routines = "\nDEF helper ( )\n  PTP HOME\nEND\nDEFFCT INT f()\nRETURN 1\nENDFCT\n"
     result = parse_krl(program(f"LIN {FULL}") + routines)
-    ignored = [(i.span.line, i.text) for i in result.ignored]
-    assert ignored == [(5, "DEF helper ( )")]  # never called, and olp cannot lower it
-    assert "is never called" in result.ignored[0].reason
-    (function,) = result.program.routines  # a function without motions is kept
+    assert result.ignored == ()
+    helper, function = result.program.routines  # a function without motions is kept
+    # never called: written, its PTP with the controller's settings (an unknown caller's)
+    assert [(n.kind, n.span.line) for n in helper.body] == [("runtime_move", 6)]
     assert (function.name, function.returns, [n.kind for n in function.body]) == (
         "f",
         "INT",

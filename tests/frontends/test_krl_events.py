@@ -174,18 +174,20 @@ def test_a_handler_routine_of_the_module_is_kept_as_a_routine() -> None:
     assert kinds == ["verbatim", "set_output", "wait_input", "set_output", "verbatim"]
 
 
-def test_a_handler_that_moves_the_robot_is_named_as_missing_from_the_output() -> None:
-    """Where a handler runs is unknown, so its motions could not be checked: not written, and
-    the warning says the written program's interrupt calls a routine it does not hold."""
+def test_a_handler_that_moves_the_robot_is_written_from_an_unknown_caller() -> None:
+    """Where a handler runs is unknown: it is lowered from the controller's settings (a plain
+    PTP runs with them) and written, with a note (it was left out with a warning)."""
     source = (
         "DEF p( )\nINTERRUPT DECL 20 WHEN $IN[3] DO Away()\nINTERRUPT ON 20\nWAIT SEC 1\nEND\n"
         "DEF Away( )\nPTP {A1 0,A2 -90,A3 90,A4 0,A5 0,A6 0}\nEND\n"
     )
     result = parse_krl(source)
-    (line,) = [i for i in result.ignored if "Away" in i.reason]
-    assert line.span.line == 6 and not result.program.routines
-    assert "runs from the interrupt at line 2" in line.reason
-    assert "moves the robot" in line.reason
+    assert not [i for i in result.ignored if "Away" in i.reason]
+    (away,) = result.program.routines
+    (ptp,) = away.body
+    assert isinstance(ptp, ir.RuntimeMove) and ptp.controller_settings
+    (note,) = [n for n in result.notes if n.span.line == 6]
+    assert "runs from the interrupt at line 2" in note.message
 
 
 def test_interrupts_and_triggers_take_no_time() -> None:

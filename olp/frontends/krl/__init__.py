@@ -125,10 +125,16 @@ What is lowered
   value where the arguments are constant; others are unknown inside; parameters not marked
   ``:IN`` are copied back to a plain variable argument), then kept as an
   :class:`~olp.ir.RoutineCall` where every call lowered the same routine
-  (:mod:`olp.frontends.krl.routines`; otherwise written out at its calls with a warning);
-  recursion is an error. Checks see each routine's body at every call
-  (:meth:`olp.ir.Program.expanded`). Routines no call reaches (interrupt handlers, functions)
-  are kept unless they move the robot. Other calls become :class:`~olp.ir.Call` (arguments as
+  (:mod:`olp.frontends.krl.routines`; where the calls differ only in why a motion runs with
+  the controller's settings, the routine lowered from an unknown caller's state; otherwise
+  written out at its calls with a warning); recursion is an error. Checks see each routine's
+  body at every call (:meth:`olp.ir.Program.expanded`). Routines no call reaches (interrupt
+  handlers, functions, a library's routines other modules or the PLC call) are lowered from an
+  unknown caller's state (every motion setting the controller's, the robot where olp does not
+  know, the module's variables known only where nothing in it changes them) and kept, with a
+  note where they move the robot: a plain motion runs with the controller's settings, an
+  inline form's is modelled, its target checked from an unknown start
+  (:attr:`olp.ir_flow.Expanded.entry`). Other calls become :class:`~olp.ir.Call` (arguments as
   source text). The program's own parameters (``DEF MoveSettings(nBase:IN, nTool:IN)``, a
   module other modules call) are :attr:`olp.ir.Program.params`, typed the same way; their
   values are the caller's, known only when the program runs.

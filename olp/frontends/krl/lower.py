@@ -13,7 +13,7 @@ from __future__ import annotations
 import dataclasses
 import os
 import re
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -30,6 +30,7 @@ from olp.frontends.krl.ast import (
     Expr,
     FastMotion,
     ForLoop,
+    FuncCall,
     IgnoredLine,
     InterruptCtl,
     InterruptDecl,
@@ -453,6 +454,16 @@ class _Lowering(Motions, Events):
             self.out.append(ir.Call(name=stmt.name, args=args, span=stmt.span))
         else:
             self._unread_call(stmt)
+
+    def _entered(self, held: str, start: str) -> None:
+        """Start a routine from what olp knows where an unknown caller enters it: what it
+        knows after a call of a routine it did not read (:meth:`_unread_call`): every motion
+        setting held by the controller (``held``: why), the robot where olp does not know
+        (``start``: why)."""
+        why = Held(held)
+        for name in _STATE_FIELDS:
+            self.ambiguous[name] = why
+        self.track.lose(RuntimeStart(start))
 
     def _unread_call(self, stmt: CallStmt) -> None:
         """A call of a routine olp did not read (another module's, an ``EXT`` one): it may set
@@ -1202,6 +1213,7 @@ def lower_module(
     table = {r.name.upper(): r for r in ordered}
     ctx = Context(sources, table, src, dat, config, MAX_LOWERED_STATEMENTS, shared)
     ctx.calls_keep_settings = calls_keep_settings
+    entry = dict(values)  # the program's lowering changes ``values``
     lowering = _Lowering(ctx, State(), _variables(values, ctx, main))
     if main is not None:
         if main.kind == "DEFFCT":  # its RETURN value gives the result: kept, as a function's
@@ -1215,9 +1227,12 @@ def lower_module(
         lowering.first_pass(main.body)
         lowering.lower_body(main.body)
         lowering.report_unwritten_settings()
-    alone = _lower_alone(ordered[1:] if main is not None else ordered, lowering, values)
+    entry_values = _entry_values(entry, routines)
+    alone = _lower_alone(ordered[1:] if main is not None else ordered, lowering, entry_values)
     body = build_instructions(lowering.out)
-    assembled = assemble(body, alone, {k: v for k, v in table.items() if v is not main}, sources)
+    others = {k: v for k, v in table.items() if v is not main}
+    entered = _entered_at_calls(lowering, entry_values, table)
+    assembled = assemble(body, alone, others, sources, entered)
     ignored = sorted(
         [*lowering.ignored, *assembled.ignored], key=lambda i: (i.span.line, i.span.column)
     )
@@ -1308,48 +1323,49 @@ def _returns_dims(main: Routine) -> tuple[ir.Expr | None, ...]:
 
 
 def _lower_alone(
-    routines: Sequence[Routine], main: _Lowering, values: Any
+    routines: Sequence[Routine], main: _Lowering, entry: dict[str, Value]
 ) -> dict[str, tuple[ir.Node, ...]]:
     """The routines no call of the program reaches (interrupt handlers, functions, routines
-    never called), each lowered on its own: upper-case name -> body. One that olp cannot
-    lower, or that moves the robot (where it runs from is unknown, so its motions could not
-    be checked), is reported and left out."""
+    never called: a library's, which other modules or the PLC call), each lowered on its own:
+    upper-case name -> body. ``entry``: the module's variables where such a routine starts
+    (:func:`_entry_values`).
+
+    Such a routine is entered from a context olp does not know, so it is lowered from exactly
+    the state olp has after a call of a routine it did not read (:meth:`_Lowering._entered`):
+    every motion setting held by the controller, the robot where olp does not know, the
+    module's variables known only where nothing assigns them. A plain motion in it then runs
+    with the controller's settings (:meth:`_Lowering._controller_settings_motion`); one whose
+    settings the routine sets itself (an inline form) is modelled: its target checked, its
+    path not (it starts where the caller left the robot). A note on the routine's head says so.
+    One that olp cannot lower is reported and left out."""
     ctx = main.ctx
     bodies: dict[str, tuple[ir.Node, ...]] = {}
     for routine in routines:
         if routine.name.upper() in ctx.called:
             continue
-        lowering = _Lowering(ctx, State(), Variables(values, ctx.unknown_name))
-        lowering.variables.push(
-            {
-                p.name.upper(): Unknown(f"{p.name} is a parameter of {routine.name}")
-                for p in routine.params
-            }
-        )
-        lowering.defining = routine.name
-        lowering.ignored, lowering.notes = main.ignored, main.notes
-        lowering.status_turn, lowering._reported = main.status_turn, main._reported
-        lowering.routine = RoutineJumps.of(routine.body)
-        reason = None
-        try:
-            lowering.first_pass(routine.body)
-            lowering.lower_body(routine.body)
-            lowering.report_unwritten_settings()
-            body = build_instructions(lowering.out)
-        except ParseError as exc:
-            reason = f"olp cannot lower it: {exc.message}"
-        else:
-            if moves(body):
-                reason = (
-                    "it moves the robot, and olp checks motions only where the program calls them"
-                )
-        if reason is None:
-            bodies[routine.name.upper()] = body
-            continue
         runs_as = ctx.handlers.get(routine.name.upper())
         what = f"runs from the {runs_as}" if runs_as is not None else "is never called"
         if routine.kind == "DEFFCT":
             what = "is a function the program does not call" if runs_as is None else what
+        held = f"{routine.name} {what}: its caller's motion settings are the controller's"
+        start = f"{routine.name} {what}: it starts where its caller left the robot"
+        reason = None
+        try:
+            body = _lower_entered(routine, main, entry, held, start)
+        except ParseError as exc:
+            reason = f"olp cannot lower it: {exc.message}"
+        if reason is None:
+            bodies[routine.name.upper()] = body
+            if moves(body):
+                main._note(
+                    routine.span,
+                    f"{routine.kind} {routine.name} {what} in this module: written, and checked "
+                    "only as far as an unknown caller allows (it starts with the controller's "
+                    "motion settings and where the caller left the robot: its plain motions run "
+                    "with the controller's settings, its inline forms' targets are checked, "
+                    "their paths from the start are not)",
+                )
+            continue
         main.ignored.append(
             IgnoredLine(
                 routine.span,
@@ -1358,6 +1374,100 @@ def _lower_alone(
             )
         )
     return bodies
+
+
+_NO_ARGUMENTS = (type, ir.SourceSpan, FastMotion, LinRows, CommentStmt)
+"""What holds no call (numbers only: a milling program's tens of thousands of rows)."""
+
+
+def _passed(node: object) -> Iterator[str]:
+    """The variables (upper case) ``node`` (statements, expressions) gives a routine or a
+    function as an argument: KRL passes a variable by reference unless the parameter is
+    ``:IN``, so the callee may change it (a routine olp did not read too)."""
+    if isinstance(node, CallStmt | FuncCall):
+        yield from (a.name.upper() for a in node.args if isinstance(a, Var))
+    if isinstance(node, tuple | list):
+        for item in node:
+            yield from _passed(item)
+    elif dataclasses.is_dataclass(node) and not isinstance(node, _NO_ARGUMENTS):
+        for f in dataclasses.fields(node):
+            yield from _passed(getattr(node, f.name))
+
+
+def _lower_entered(
+    routine: Routine,
+    main: _Lowering,
+    entry: dict[str, Value],
+    held: str,
+    start: str,
+    reports: bool = True,
+) -> tuple[ir.Node, ...]:
+    """``routine``'s body lowered from an unknown caller's state (:meth:`_Lowering._entered`,
+    ``held`` and ``start`` the reasons), the module's variables at ``entry``; what it reports
+    goes to ``main``'s reports, or nowhere without ``reports``. Raises :class:`ParseError`."""
+    ctx = main.ctx
+    lowering = _Lowering(ctx, State(), Variables(dict(entry), ctx.unknown_name))
+    lowering.variables.push(
+        {
+            p.name.upper(): Unknown(f"{p.name} is a parameter of {routine.name}")
+            for p in routine.params
+        }
+    )
+    lowering.defining = routine.name
+    if reports:
+        lowering.ignored, lowering.notes = main.ignored, main.notes
+        lowering.status_turn, lowering._reported = main.status_turn, main._reported
+    lowering.routine = RoutineJumps.of(routine.body)
+    lowering._entered(held, start)
+    lowering.first_pass(routine.body)
+    lowering.lower_body(routine.body)
+    lowering.report_unwritten_settings()
+    return build_instructions(lowering.out)
+
+
+def _entered_at_calls(
+    main: _Lowering, entry: dict[str, Value], table: dict[str, Routine]
+) -> Callable[[str, Sequence[int]], tuple[ir.Node, ...] | None]:
+    """For :func:`~olp.frontends.krl.routines.assemble`: a routine (upper-case name) lowered
+    from an unknown caller's state, for calls (their lines) that all run it with the
+    controller's settings and the robot where olp does not know; None where olp cannot lower
+    it so. Its reports are dropped: each call's lowering made them."""
+
+    def lower(name: str, lines: Sequence[int]) -> tuple[ir.Node, ...] | None:
+        routine = table[name]
+        at = ", ".join(str(line) for line in lines)
+        held = (
+            f"{routine.name} runs with its callers' motion settings, which the controller holds "
+            f"at each of its calls (lines {at})"
+        )
+        start = f"{routine.name} starts where its callers left the robot (lines {at})"
+        try:
+            return _lower_entered(routine, main, entry, held, start, reports=False)
+        except ParseError:
+            return None
+
+    return lower
+
+
+def _entry_values(values: dict[str, Value], module: Sequence[Routine]) -> dict[str, Value]:
+    """The module's variables where a caller olp does not follow enters a routine (one no call
+    of the program reaches, :func:`_lower_alone`, or one whose calls all run it with the
+    controller's settings, :func:`_entered_at_calls`):
+    their declared (data-list) values where nothing in the module assigns them, else known only
+    when the program runs (another routine, an earlier run of this one, or a routine olp did
+    not read given it by reference may have changed it)."""
+    assigned: set[str] = set()
+    for routine in module:
+        assigned |= assigned_names(routine.body) | set(_passed(routine.body))
+    return {
+        name: Unknown(
+            f"{name} is assigned in the module: where a caller olp does not follow enters a "
+            "routine, its value is known only when the program runs"
+        )
+        if name in assigned
+        else value
+        for name, value in values.items()
+    }
 
 
 def _routines(module: Module, sources: SourceSet, src: str) -> list[Routine]:

@@ -17,15 +17,18 @@ and wraps what it lowered in a :class:`PendingCall`. :func:`assemble` then decid
   routine is written out at each call, as olp did before it kept routines, with a warning that
   names the first statement that differs and two calls that differ there.
 
-Routines no call reaches (interrupt handlers, functions, routines never called) are lowered
-once on their own (parameters unknown, motion settings the controller's defaults) by
-:mod:`olp.frontends.krl.lower` and kept when they do not move the robot: where such a routine
-runs from, olp cannot know, so a motion in it could not be checked.
+Routines no call reaches (interrupt handlers, functions, a library's routines that other
+modules or the PLC call) are lowered once on their own by :mod:`olp.frontends.krl.lower`, from
+what olp knows where an unknown caller enters them (parameters unknown, every motion setting
+the controller's, the robot where olp does not know): a plain motion in one runs with the
+controller's settings, an inline form's is modelled; the checks take such a routine from an
+unknown start (:attr:`olp.ir_flow.Expanded.entry`).
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Sequence
+import dataclasses
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -78,10 +81,13 @@ def assemble(
     alone: dict[str, tuple[Any, ...]],
     table: dict[str, Routine],
     sources: SourceSet,
+    entered: Callable[[str, Sequence[int]], tuple[Any, ...] | None] | None = None,
 ) -> Assembled:
     """The program from the main body ``main`` and the bodies ``alone`` of the routines lowered
     on their own (upper-case name -> body), ``table`` the module's routines by upper-case
-    name (see the module docstring)."""
+    name (see the module docstring). ``entered``: a routine (upper-case name) lowered from an
+    unknown caller's state for the calls at the lines given, None where olp cannot: the one
+    text of calls that differ only in why a motion runs with the controller's settings."""
     found: dict[str, list[PendingCall]] = {}
     for call in calls_in([*main, *(n for body in alone.values() for n in body)]):
         found.setdefault(call.call.name.upper(), []).append(call)
@@ -96,6 +102,9 @@ def assemble(
         elif generic is not None:
             kept.add(name)
             bodies[name] = generic
+        elif (unknown := _entered_text(name, calls, entered)) is not None:
+            kept.add(name)
+            bodies[name] = unknown
         else:
             routine = table[name]
             reason = _written_out(routine, len(calls), *differ)
@@ -165,6 +174,50 @@ def _generic(calls: Sequence[PendingCall]) -> tuple[Any, ...] | None:
     if any([n for n in _flat(c.body) if ir.is_motion(n)] != motions for c in calls):
         return None
     return first
+
+
+def _entered_text(
+    name: str,
+    calls: Sequence[PendingCall],
+    entered: Callable[[str, Sequence[int]], tuple[Any, ...] | None] | None,
+) -> tuple[Any, ...] | None:
+    """The routine lowered from an unknown caller's state (``entered``) where every call's
+    body is that text, but for why its motions run with the controller's settings (a
+    ``MovPlcSck()`` after ``Pattern(...)``, a routine olp did not read, at each call: the
+    calls say which call of ``Pattern``, the text says the callers'); else None."""
+    if entered is None or not any(
+        isinstance(n, ir.RuntimeMove) and n.controller_settings for n in _flat(calls[0].body)
+    ):
+        return None
+    unknown = entered(name, sorted({c.span.line for c in calls}))
+    if unknown is None:
+        return None
+    text = _text(unknown)
+    return unknown if all(_text(c.body) == text for c in calls) else None
+
+
+def _text(nodes: Sequence[Any]) -> tuple[Any, ...]:
+    """``nodes`` as the routine's text: a motion with the controller's settings without why
+    (and without olp's settings, which the posts do not write for it), a call with its body."""
+
+    def edit(node: Any) -> list[Any]:
+        if isinstance(node, ir.RuntimeMove) and node.controller_settings:
+            blank = ir.RuntimeMove(motion=node.motion, target=node.target, span=node.span)
+            return [
+                dataclasses.replace(
+                    node,
+                    reason="",
+                    speed=blank.speed,
+                    zone=blank.zone,
+                    tool=blank.tool,
+                    frame=blank.frame,
+                )
+            ]
+        if isinstance(node, PendingCall):
+            return [(node.call, _text(node.body))]
+        return [node]
+
+    return map_leaves(nodes, edit)
 
 
 def _flat(nodes: Sequence[Any]) -> Iterator[Any]:

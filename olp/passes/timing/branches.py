@@ -494,7 +494,11 @@ class _Walk:
 
     def expanded(self, node: ir.Expanded, states: States) -> States:
         """A routine's body at its call site; a return inside ends the routine, not the
-        program, and an EXIT inside leaves no loop of the caller."""
+        program, and an EXIT inside leaves no loop of the caller. An entry (a routine no call
+        runs, :attr:`olp.ir_flow.Expanded.entry`) is no part of the program's time."""
+        if node.entry:
+            self.cursor += _size(node.body)
+            return states
         saved = self.exits
         self.exits = []
         self.returns.append({})
@@ -829,9 +833,13 @@ def path_timing_pass(compiled: CompiledProgram, options: BuildOptions) -> Compil
 
 def _one_path(program: ir.Program) -> bool:
     """Whether the text in order is the program's only path: declarations, assignments and
-    waits, but no block, jump, exit or return."""
+    waits, but no block, jump, exit or return, and no entry (a routine no call runs, whose
+    steps follow the program's and are no part of its time: the walk leaves them out)."""
     turns = tuple(t for t in (*BLOCK_TYPES, ir.Goto, ir.Exit, ir.Return) if t is not ir.Expanded)
-    return not any(isinstance(n, turns) for n in leaves_and_blocks(program.instructions))
+    return not any(
+        isinstance(n, turns) or (isinstance(n, ir.Expanded) and n.entry)
+        for n in leaves_and_blocks(program.instructions)
+    )
 
 
 def _note(compiled: CompiledProgram, paths: PathTimes) -> Diagnostic:

@@ -97,6 +97,8 @@ class _Unroll:
         return None
 
     def block(self, node: Any, label: str | None) -> str | None:
+        if isinstance(node, ir.Expanded) and node.entry:  # no part of the program's run
+            return None
         if isinstance(node, ir.Expanded):
             self.body(node.body)  # a RETURN inside ends the routine, and the caller goes on
             return None
