@@ -13,6 +13,8 @@ REPO = Path(__file__).resolve().parents[2]
 CELL = str(REPO / "stations" / "kr6_milling_cell.yaml")
 
 BAD = """DEF bad( )
+$TOOL = $NULLFRAME
+$BASE = $NULLFRAME
 $VEL.CP = 0.5
 PTP {A1 0,A2 -90,A3 90,A4 0,A5 30,A6 0}
 LIN {X 5000,Y 0,Z 500,A 0,B 90,C 0}
@@ -45,7 +47,7 @@ def test_sarif_points_at_the_source_line(tmp_path: Path) -> None:
     (result,) = run["results"]
     assert result["ruleId"] == "unreachable" and result["level"] == "error"
     region = result["locations"][0]["physicalLocation"]["region"]
-    assert region["startLine"] == 4
+    assert region["startLine"] == 6
     assert run["tool"]["driver"]["rules"][result["ruleIndex"]]["id"] == "unreachable"
 
 

@@ -927,6 +927,8 @@ def _ur_screw_program(tmp_path: Path) -> Path:
     program = tmp_path / "screw.src"
     program.write_text(
         "DEF Screw( )\n"
+        "$TOOL = $NULLFRAME\n"
+        "$BASE = $NULLFRAME\n"
         "PTP {A1 0,A2 -90,A3 90,A4 -90,A5 -90,A6 0}\n"
         "$TOOL = TOOL_DATA[1]\n"
         "PTP {A1 20,A2 -80,A3 100,A4 -110,A5 -90,A6 0}\n"
