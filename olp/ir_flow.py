@@ -448,6 +448,11 @@ class Parameter:
     ``"out"``, passed by reference (the routine reads the caller's variable and its changes are
     the caller's: KRL ``:OUT``, and KRL's default when a parameter has no mark). A post that can
     pass only by value must refuse an ``"out"`` parameter, never pass it by value silently.
+
+    ``head_dims``: how the source's routine head marks the parameter, where the language
+    marks arrays there (KRL ``sText[]:IN`` 1, ``xPath[,]:OUT`` 2, ``nTool:IN`` 0; a head may mark
+    fewer than the declaration has); None where no head said (a post of that language marks
+    ``dims``). A post of the source's language writes the head as it was.
     """
 
     name: str
@@ -455,6 +460,7 @@ class Parameter:
     dims: tuple[Expr | None, ...] = ()
     direction: str = "in"
     span: SourceSpan = GENERATED
+    head_dims: int | None = None
 
     def __post_init__(self) -> None:
         if not self.name:
@@ -465,6 +471,8 @@ class Parameter:
                 f"got {self.direction!r}"
             )
         object.__setattr__(self, "dims", _tuple(self.dims))
+        if self.head_dims is not None and self.head_dims < 0:
+            raise FlowError(f"Parameter.head_dims must be 0 or more, got {self.head_dims}")
 
     @property
     def by_reference(self) -> bool:

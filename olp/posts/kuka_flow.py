@@ -148,8 +148,7 @@ def krl_routine_head(routine: ir.Routine) -> str:
     dimensions (``sText[]:IN``, ``rMatrix[,]:OUT``). Its type is declared in the body
     (:func:`krl_param_decl`)."""
     params = ", ".join(
-        f"{p.name}{_empty_index(p.dims)}:{'OUT' if p.by_reference else 'IN'}"
-        for p in routine.params
+        f"{p.name}{_head_index(p)}:{'OUT' if p.by_reference else 'IN'}" for p in routine.params
     )
     prefix = "GLOBAL " if routine.exported else ""
     if routine.returns is None:
@@ -197,6 +196,14 @@ def krl_program_head(
         exported=exported,
     )
     return krl_routine_head(head)
+
+
+def _head_index(param: ir.Parameter) -> str:
+    """A parameter's brackets in the head: as the source's head had them
+    (:attr:`olp.ir.Parameter.head_dims`), else one position per declared dimension."""
+    if param.head_dims is None:
+        return _empty_index(param.dims)
+    return f"[{',' * (param.head_dims - 1)}]" if param.head_dims else ""
 
 
 def _empty_index(dims: tuple[object, ...]) -> str:

@@ -301,3 +301,39 @@ def test_a_program_written_under_another_name_is_a_warning(
         (warning,) = renamed
         assert warning.severity == "warning" and f"written as {written}:" in warning.message
         assert f"{written}.src" in result.files
+
+
+HEADS = """DEF heads( )
+DECL POS xGrid[2,3]
+DECL CHAR sName[12]
+sName[] = "cell"
+Fill(xGrid[,])
+Show(sName[])
+END
+
+DEF Fill(xPath[]:OUT)
+DECL POS xPath[,]
+xPath[1,1] = {X 0,Y 0,Z 0,A 0,B 0,C 0}
+END
+
+DEF Show(sText:IN)
+CHAR sText[]
+$OUT[1] = TRUE
+END
+"""
+
+
+def test_routine_heads_mark_array_parameters_as_the_source_does(
+    station: object, tmp_path: Path
+) -> None:
+    """KRL to KRL writes a head's brackets as read (``xPath[]`` of a two-dimensional array,
+    ``sText`` of a string) rather than one position per declared dimension."""
+    src = tmp_path / "heads.src"
+    src.write_text(HEADS)
+    params = {p.name: p for r in load_krl(src).program.routines for p in r.params}
+    assert (params["xPath"].head_dims, len(params["xPath"].dims)) == (1, 2)
+    assert (params["sText"].head_dims, len(params["sText"].dims)) == (0, 1)
+    result = olp.build(station, src, post="kuka", collisions=None)
+    assert result.ok, [d.format() for d in result.diagnostics if d.severity == "error"]
+    heads = [line for line in result.files["heads.src"].splitlines() if line.startswith("DEF ")]
+    assert heads == ["DEF heads( )", "DEF Fill(xPath[]:OUT)", "DEF Show(sText:IN)"]

@@ -441,7 +441,7 @@ Stmt: TypeAlias = (
 class Param:
     name: str
     direction: str | None  # "IN", "OUT" or not given
-    array: bool = False  # written with empty brackets: sText[]:IN
+    head_dims: int = 0  # the empty brackets' dimensions in the head: sText[]:IN 1, x[,] 2
 
 
 @dataclass(frozen=True, slots=True)

@@ -227,9 +227,8 @@ class _ToAst(Transformer[Token, Module]):
 
     @_inline
     def param(self, meta: Meta, name: Token, array: Token | None, direction: Token | None) -> Param:
-        return Param(
-            str(name), None if direction is None else str(direction).upper(), array is not None
-        )
+        dims = 0 if array is None else str(array).count(",") + 1
+        return Param(str(name), None if direction is None else str(direction).upper(), dims)
 
     @_inline
     def dat_block(self, meta: Meta, name: Token, public: Any, body: tuple[Stmt, ...]) -> DatBlock:

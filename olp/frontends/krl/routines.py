@@ -273,6 +273,7 @@ def typed_params(
                 dims=() if decl is None else decl.dims,
                 direction="in" if p.direction == "IN" else "out",
                 span=routine.span if decl is None else decl.span,
+                head_dims=p.head_dims,
             )
         )
     return tuple(params), rest
