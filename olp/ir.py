@@ -564,6 +564,10 @@ class RuntimeMove:
     offsets added to the start's axis values (``PTP_REL {A1 10}``), ``"start"`` a position
     whose components left out are the start's (``LIN {Z 500}``). Only a post of the source's
     language writes such a target (its meaning is the source language's); the others refuse.
+    ``approximated``: with ``controller_settings``, the source's approximation words (KRL
+    ``C_DIS``, ``C_PTP C_DIS``), which a post of the source's language writes after the target,
+    so the controller approximates with the distances it holds, as the source did; empty: an
+    exact stop.
 
     Passes cannot check it (reach, limits, collisions) or time it, and the motion after it
     starts where olp does not know (:mod:`olp.passes.resolve`); a post writes it back where
@@ -585,10 +589,17 @@ class RuntimeMove:
     controller_settings: bool = False
     relative: Literal["base", "tool", "axes", "start"] | None = None
     spline: bool = False
+    approximated: tuple[str, ...] = ()
     span: SourceSpan = GENERATED
     kind: Literal["runtime_move"] = field(default="runtime_move", init=False)
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "approximated", tuple(self.approximated))
+        if self.approximated and not self.controller_settings:
+            raise IRError("RuntimeMove.approximated is for a motion with controller_settings")
+        for word in self.approximated:
+            if not (isinstance(word, str) and word.isascii() and word.isidentifier()):
+                raise IRError(f"RuntimeMove.approximated: a word of letters, got {word!r}")
         if self.motion not in RUNTIME_MOTIONS:
             raise IRError(
                 f"RuntimeMove.motion must be one of {RUNTIME_MOTIONS}, got {self.motion!r}"

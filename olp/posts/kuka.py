@@ -66,6 +66,7 @@ from olp.posts.kuka_flow import (
     EVENT_KINDS,
     flow_expr_problem,
     flow_problem,
+    krl_approximation,
     krl_call,
     krl_decl,
     krl_declaration,
@@ -471,6 +472,7 @@ FILTERS: Mapping[str, Filter] = {
     "krl_param_decl": lambda post, param: krl_param_decl(param),
     "krl_call": lambda post, call: krl_call(call),
     "krl_return": lambda post, node: krl_return(node),
+    "krl_approximation": lambda post, words: krl_approximation(words),
 }
 
 

@@ -147,3 +147,52 @@ def test_a_setting_in_a_block_before_an_unread_call_is_an_error(tmp_path: Path) 
     with pytest.raises(ParseError, match="inside a block no motion of which runs with them") as err:
         _build(tmp_path, text)
     assert err.value.span is not None and err.value.span.line == 6
+
+
+APPROXIMATED = """DEF cell( )
+EXT SetFrames(INT:IN, INT:IN)
+PTP {A1 0, A2 -90, A3 90, A4 0, A5 45, A6 0}
+SetFrames(1, 2)
+PTP {A1 10, A2 -90, A3 90, A4 0, A5 45, A6 0} C_PTP C_DIS
+LIN {X 500, Y 0, Z 600, A 0, B 90, C 0} c_dis
+LIN {X 500, Y 0, Z 650, A 0, B 90, C 0}
+END
+"""
+
+
+def test_a_motion_with_the_controllers_settings_keeps_its_approximation(tmp_path: Path) -> None:
+    """The controller holds the approximation distances too, so the KRL output approximates
+    where the source did (it used to write an exact stop, another path than the source's)."""
+    src = tmp_path / "cell.src"
+    src.write_text(APPROXIMATED)
+    result = olp.build(olp.load_station(STATION), src, post="kuka", collisions=None)
+    assert result.ok, [d.format() for d in result.diagnostics if d.severity == "error"]
+    moves = [n for n in result.compiled.program.instructions if isinstance(n, ir.RuntimeMove)]
+    assert [m.approximated for m in moves] == [("C_PTP", "C_DIS"), ("C_DIS",), ()]
+    lines = result.files["cell.src"].splitlines()
+    assert [line for line in lines if line.startswith(("PTP {A1 10", "LIN"))] == [
+        "PTP {A1 10, A2 -90, A3 90, A4 0, A5 45, A6 0} C_PTP C_DIS",
+        "LIN {X 500, Y 0, Z 600, A 0, B 90, C 0} C_DIS",
+        "LIN {X 500, Y 0, Z 650, A 0, B 90, C 0}",
+    ]
+
+
+@pytest.mark.parametrize(
+    ("fields", "problem"),
+    [
+        ({"approximated": ("C_DIS",)}, "controller_settings"),
+        ({"approximated": ("C_DIS\nHALT",), "controller_settings": True}, "a word"),
+    ],
+)
+def test_approximation_words_are_checked_when_made(fields: dict, problem: str) -> None:
+    with pytest.raises(ir.IRError, match=problem):
+        ir.RuntimeMove(motion="linear", target=ir.Name(name="xP1"), **fields)
+
+
+def test_the_krl_post_writes_only_krls_approximation_words() -> None:
+    from olp.errors import PostError
+    from olp.posts.kuka_flow import krl_approximation
+
+    assert krl_approximation(("c_ptp", "C_DIS")) == " C_PTP C_DIS"
+    with pytest.raises(PostError, match="C_FAST"):
+        krl_approximation(("C_FAST",))

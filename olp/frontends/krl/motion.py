@@ -422,12 +422,6 @@ class Motions(InlineForms):
             "(olp writes none before it)"
         )
         why = "; ".join(sorted(set(unsettled.values())))
-        if stmt.approx:
-            self._note(
-                stmt.span,
-                f"{' '.join(stmt.approx)} with the controller's settings: the approximation "
-                "distance is unknown to olp; written as an exact stop",
-            )
         self.out.append(
             ir.RuntimeMove(
                 motion=_RUNTIME_KINDS[base],
@@ -437,6 +431,7 @@ class Motions(InlineForms):
                 controller_settings=True,
                 spline=stmt.keyword.upper() in _SPLINE_MOTIONS,
                 relative=relative,
+                approximated=tuple(word.upper() for word in stmt.approx),
                 span=stmt.span,
             )
         )
