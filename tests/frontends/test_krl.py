@@ -404,7 +404,7 @@ def test_other_routines_are_listed() -> None:
         ("LIN {X 1,Y 2,Z 3,A 0,B 0,C 0,Q 1}", 30, "'Q'"),
         ("LIN {X 1,X 1,Y 2,Z 3,A 0,B 0,C 0}", 10, "twice"),
         ("$VEL.CP = 0", 11, "> 0"),
-        ("$VEL.CP = speed", 11, "'speed'"),
+        ("$VEL.CP = TRUE", 11, "'TRUE'"),  # (a run-time value is kept as written)
         ("$VEL_AXIS[1] = 150", 16, "150"),
         ("WAIT SEC -1", 10, ">= 0"),
         ("LIN {X 1e999,Y 2,Z 3,A 0,B 0,C 0}", 8, "out of range"),

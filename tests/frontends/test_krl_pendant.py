@@ -527,15 +527,19 @@ def test_for_with_a_runtime_bound_is_a_block() -> None:
     assert isinstance(block, ir.For) and block.variable == "i"
     assert block.stop == ir.Name(name="n", span=block.stop.span)
     assert [(i.kind, i.span.line) for i in block.body] == [("linear", 5)]
-    error = parse_error("FOR i = 1 TO n", "  $VEL.CP = i", "ENDFOR")
-    assert "i counts the FOR loop at line 2" in error.message
+    # the counter is known only at run time: the speed it sets is kept as written, and held
+    result = parse("DECL INT n", "FOR i = 1 TO n", "  $VEL.CP = i", "ENDFOR", f"LIN {FULL}")
+    loop, move = result.program.instructions[-2:]
+    assert isinstance(loop, ir.For) and isinstance(loop.body[0], ir.Verbatim)
+    assert "i counts the FOR loop at line 3" in loop.body[0].reason
+    assert isinstance(move, ir.RuntimeMove) and move.controller_settings
 
 
 def test_variables_assigned_in_skipped_blocks_become_unknown() -> None:
-    error = parse_error(
-        "DECL REAL v", "v = 0.5", "IF $IN[1] THEN", "  v = 1", "ENDIF", "$VEL.CP = v"
-    )
-    assert "IF at line 4" in error.message and error.span is not None and error.span.line == 7
+    result = parse("DECL REAL v", "v = 0.5", "IF $IN[1] THEN", "  v = 1", "ENDIF", "$VEL.CP = v")
+    kept = result.program.instructions[-1]  # a value of the run: kept as written
+    assert isinstance(kept, ir.Verbatim) and kept.span.line == 7
+    assert "IF at line 4" in kept.reason
 
 
 @pytest.mark.parametrize("block", ["IF $IN[1] THEN", "WHILE $IN[2]", "LOOP", "SWITCH n\nCASE 1"])

@@ -84,6 +84,13 @@ What is lowered
   fold): a run-time motion with the controller's settings, the settings statements olp
   absorbed since the first of those BAS kept as written before it. A settings routine without
   motions builds.
+* **Motion settings from run-time values** (``$VEL.CP = rProbeSpeed``, ``$ACC.CP = acc`` with
+  ``acc`` a parameter, ``$VEL_AXIS[i] = scale * 100``, ``$APO.CDIS``, ``$ORI_TYPE``,
+  ``$BASE = BASE_DATA[nBase]``) are kept as written (another post refuses them) and hold that
+  setting (:class:`~olp.frontends.krl.state.Held`; the speed part by part,
+  :data:`~olp.frontends.krl.state.SPEED_PARTS`): a motion that runs with it before the program
+  sets it again runs with the controller's settings, unchecked and untimed. One computed from
+  the counter of a FOR loop with constant bounds is not: the loop is unrolled.
 * **Unrolled FOR loops** write ``counter = n`` before a pass whose output reads the counter
   (a run-time motion such as ``LIN xPath[i]``, a statement kept as written such as
   ``r[i] = $OV_PRO``, ``Foo(i)``). One whose body only sets motion settings olp models

@@ -22,8 +22,10 @@ from olp.frontends.krl.ast import (
 )
 from olp.frontends.krl.native import INITMOV
 from olp.frontends.krl.state import (
+    ACC_AXIS_PARTS,
     KRL_ONLY_SYSTEM_VARIABLES,
     SYSTEM_REASONS,
+    VEL_AXIS_PARTS,
     WRITTEN,
     Core,
     Held,
@@ -46,20 +48,22 @@ _BAS_READS: dict[str, tuple[str, ...]] = {
 }
 """What each BAS command reads: its value argument and the inline forms' data records."""
 
+_PTP_SPEEDS = ("vel_axis", "acc_axis", "speed", *VEL_AXIS_PARTS, *ACC_AXIS_PARTS)
 _BAS_SETS: dict[str, tuple[str, ...]] = {
-    "VEL_CP": ("speed",),
-    "VEL_PTP": ("vel_axis", "speed"),
-    "ACC_PTP": ("acc_axis", "speed"),
+    "VEL_CP": ("speed", "vel_cp"),
+    "VEL_PTP": ("vel_axis", "speed", *VEL_AXIS_PARTS),
+    "ACC_PTP": ("acc_axis", "speed", *ACC_AXIS_PARTS),
     "TOOL": ("tool",),
     "BASE": ("frame",),
     "FRAMES": ("tool", "frame"),
-    "PTP_DAT": ("vel_axis", "acc_axis", "speed", "cdis_mm"),
-    "CP_DAT": ("speed", "cdis_mm"),
-    "PTP_PARAMS": ("vel_axis", "acc_axis", "speed", "cdis_mm", "tool", "frame"),
-    "CP_PARAMS": ("speed", "cdis_mm", "tool", "frame"),
+    "PTP_DAT": (*_PTP_SPEEDS, "cdis_mm"),
+    "CP_DAT": ("speed", "vel_cp", "cdis_mm"),
+    "PTP_PARAMS": (*_PTP_SPEEDS, "cdis_mm", "tool", "frame"),
+    "CP_PARAMS": ("speed", "vel_cp", "cdis_mm", "tool", "frame"),
 }
-"""The motion settings (fields of :class:`~olp.frontends.krl.state.State`) each BAS command
-sets, as :meth:`InlineForms._bas_handlers` lowers them."""
+"""The motion settings (fields of :class:`~olp.frontends.krl.state.State` and the parts of the
+speed held apart, :data:`~olp.frontends.krl.state.SPEED_PARTS`) each BAS command sets, as
+:meth:`InlineForms._bas_handlers` lowers them."""
 
 
 class InlineForms(Core):

@@ -70,6 +70,7 @@ from olp.frontends.krl.routines import PendingCall, assemble, moves, typed_param
 from olp.frontends.krl.rows import build_instructions
 from olp.frontends.krl.state import (
     DEFAULT_VEL_CP,
+    SPEED_PARTS,
     Context,
     Held,
     KrlResult,
@@ -81,6 +82,7 @@ from olp.frontends.krl.state import (
 )
 from olp.frontends.krl.values import (
     Bool,
+    Counter,
     Num,
     Signal,
     Unknown,
@@ -206,11 +208,14 @@ class _Lowering(Motions, Events):
     @state.setter
     def state(self, new: State) -> None:
         """Setting a motion setting again ends its ambiguity (a field assigned anew is a new
-        object, so identity tells which ones a statement set)."""
+        object, so identity tells which ones a statement set). Not a part of the speed held
+        apart (:data:`~olp.frontends.krl.state.SPEED_PARTS`): the setter of that part settles
+        it, as one ``speed`` object cannot tell which of its parts changed."""
         if self.ambiguous:
             old = self._state
-            for name in [n for n in self.ambiguous if getattr(new, n) is not getattr(old, n)]:
-                del self.ambiguous[name]
+            changed = [n for n in _STATE_FIELDS if getattr(new, n) is not getattr(old, n)]
+            for name in changed:
+                self.ambiguous.pop(name, None)
         if self.unset:
             old = self._state
             self.unset -= {n for n in self.unset if getattr(new, n) is not getattr(old, n)}
@@ -484,6 +489,7 @@ class _Lowering(Motions, Events):
         why = Held(f"the call of {stmt.name} at line {line} runs a routine olp did not read")
         for name in _STATE_FIELDS:
             self.ambiguous[name] = why
+        self._hold(self.call_holds(), why)
         self.track.lose(RuntimeStart(f"{why}, which may move the robot"))
         args = tuple("" if arg is None else self.sources.snippet(arg.span) for arg in stmt.args)
         self.out.append(ir.Call(name=stmt.name, args=args, may_move=True, span=stmt.span))
@@ -768,7 +774,7 @@ class _Lowering(Motions, Events):
         no motion to a run-time target, or with as many as when the counter is ``first`` (the
         targets are the run's whatever the counter: ``LIN pts[i]`` of an array declared in a
         file olp was not given; unrolling would only repeat run-time motions)."""
-        unknown = Unknown(f"{stmt.counter} counts the FOR loop at line {stmt.span.line}")
+        unknown = Counter(f"{stmt.counter} counts the FOR loop at line {stmt.span.line}")
         if self._probe_for(stmt, unknown, runtime=False) is not None:
             return True
         blind = self._probe_for(stmt, unknown, runtime=True)
@@ -1185,6 +1191,7 @@ _SETTING_NAMES = {
     "frame": "$BASE",
     "ori_type": "$ORI_TYPE",
     "circ_type": "$CIRC_TYPE",
+    **SPEED_PARTS,
 }
 
 
@@ -1350,6 +1357,7 @@ def _lower_alone(
         held = f"{routine.name} {what}: its caller's motion settings are the controller's"
         start = f"{routine.name} {what}: it starts where its caller left the robot"
         reason = None
+        called = set(ctx.called)
         try:
             body = _lower_entered(routine, main, entry, held, start)
         except ParseError as exc:
@@ -1366,6 +1374,8 @@ def _lower_alone(
                     "their paths from the start are not)",
                 )
             continue
+        # the routines it called are written only through it: each is lowered on its own then
+        ctx.called.intersection_update(called)
         main.ignored.append(
             IgnoredLine(
                 routine.span,

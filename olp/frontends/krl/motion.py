@@ -28,7 +28,10 @@ from olp.frontends.krl.fast import materialise, row_motions
 from olp.frontends.krl.flow import to_expr
 from olp.frontends.krl.inline import InlineForms
 from olp.frontends.krl.state import (
+    ACC_AXIS_PARTS,
     DEFAULT_VEL_CP,
+    PATH_SPEED_PARTS,
+    VEL_AXIS_PARTS,
     Cartesian,
     Held,
     Pending,
@@ -67,18 +70,20 @@ _LIN_APPROX = frozenset({("C_DIS",), ("C_DIS", "C_DIS")})
 _FAST_KEYWORDS = {"PTP": "PTP", "SPTP": "PTP", "LIN": "LIN", "SLIN": "LIN"}
 _AXIS_SET = frozenset(AXES)
 _CARTESIAN_SET = frozenset(CARTESIAN)
+_AXIS_PARTS = frozenset({*VEL_AXIS_PARTS, *ACC_AXIS_PARTS})
 _USED_SETTINGS: dict[str, frozenset[str]] = {
-    "PTP": frozenset({"vel_axis", "acc_axis", "speed", "tool", "frame"}),
-    "LIN": frozenset({"speed", "tool", "frame", "ori_type"}),
-    "CIRC": frozenset({"speed", "tool", "frame", "ori_type", "circ_type"}),
+    "PTP": frozenset({"vel_axis", "acc_axis", "speed", "tool", "frame"}) | _AXIS_PARTS,
+    "LIN": frozenset({"speed", "tool", "frame", "ori_type", *PATH_SPEED_PARTS}),
+    "CIRC": frozenset({"speed", "tool", "frame", "ori_type", "circ_type", *PATH_SPEED_PARTS}),
 }
 """The motion settings (fields of :class:`~olp.frontends.krl.state.State`) a motion of each
-kind runs with, besides ``cdis_mm`` when it is approximated (see :meth:`Motions._unsettled`)."""
+kind runs with, besides ``cdis_mm`` when it is approximated (see :meth:`Motions._unsettled`),
+and the parts of the speed held apart (:data:`~olp.frontends.krl.state.SPEED_PARTS`)."""
 _WITH_SETS: dict[tuple[str, bool], frozenset[str]] = {
-    ("$VEL_AXIS[]", True): frozenset({"vel_axis", "speed"}),
-    ("$ACC_AXIS[]", True): frozenset({"acc_axis"}),
-    ("$VEL", False): frozenset({"speed"}),
-    ("$VEL.CP", False): frozenset({"speed"}),
+    ("$VEL_AXIS[]", True): frozenset({"vel_axis", "speed", *VEL_AXIS_PARTS}),
+    ("$ACC_AXIS[]", True): frozenset({"acc_axis", *ACC_AXIS_PARTS}),
+    ("$VEL", False): frozenset({"speed", "vel_cp"}),
+    ("$VEL.CP", False): frozenset({"speed", "vel_cp"}),
     ("$TOOL", True): frozenset({"tool"}),
     ("$TOOL", False): frozenset({"tool"}),
     ("$BASE", True): frozenset({"frame"}),
@@ -376,7 +381,9 @@ class Motions(InlineForms):
         base, path speed and distance again (``BAS(#CP_PARAMS, 2)`` with known data), is
         lowered as any: the axis speeds that BAS left unknown are not its settings. The speed
         is one setting in olp (:class:`olp.ir.Speed`): what sets either part of it counts for
-        both (conservative: a LIN right after a run-time ``BAS(#VEL_PTP)`` still stops). What
+        both (conservative: a LIN right after a run-time ``BAS(#VEL_PTP)`` still stops); its
+        parts held from run-time values (:data:`~olp.frontends.krl.state.SPEED_PARTS`) are
+        held one by one: a PTP is not held by a run-time ``$VEL.CP``, a LIN is. What
         the motion's own WITH sets (a spline inline form's ``$TOOL = STOOL2(FP1)``, ...) is not
         ambiguous for it."""
         ambiguous: dict[str, str] = getattr(self, "ambiguous", {})

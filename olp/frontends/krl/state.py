@@ -53,6 +53,7 @@ from olp.frontends.krl.values import (
     POS_TYPES,
     ArrayValue,
     Bool,
+    Counter,
     Evaluator,
     Signal,
     Unknown,
@@ -61,6 +62,7 @@ from olp.frontends.krl.values import (
     as_int,
     as_number,
     frame_values,
+    variables_read,
 )
 from olp.vendors.kuka import ARC_ORIENTATIONS, frame_to_pose
 
@@ -113,15 +115,54 @@ CIRC_TYPES = frozenset({"BASE", "PATH"})
 
 class Held(str):
     """Why a motion setting is ambiguous, when it is because the controller holds a value only
-    the run time knows: a BAS given run-time values, ``$BASE``/``$TOOL`` set from a run-time
-    value (both kept as written), a call of a routine olp did not read (which may set any of
-    them). A motion that runs with such a setting runs with the controller's settings, which
-    the output leaves as the source does (:meth:`olp.frontends.krl.motion.Motions.
-    _controller_settings_motion`); one that differs between paths olp lowered is not held
-    (olp absorbed the statements that set it, so it cannot leave it to the controller). A
-    ``str`` so that the reasons read as any other."""
+    the run time knows: a BAS given run-time values, a motion setting (``$VEL.CP``,
+    ``$BASE``, ...) assigned a run-time value (both kept as written), a call of a routine olp
+    did not read (which may set any of them). A motion that runs with such a setting runs with
+    the controller's settings, which the output leaves as the source does
+    (:meth:`olp.frontends.krl.motion.Motions._controller_settings_motion`); one that differs
+    between paths olp lowered is not held (olp absorbed the statements that set it, so it
+    cannot leave it to the controller). A ``str`` so that the reasons read as any other.
+
+    The speed's parts are held one by one (:data:`SPEED_PARTS`): ``$ACC.CP = 2`` after a
+    run-time ``$VEL.CP`` leaves the path speed held."""
 
     __slots__ = ()
+
+
+def axis_parts(field_name: str, axes: Sequence[int]) -> tuple[str, ...]:
+    """The keys of ``axes`` (1-based) of ``field_name`` (``vel_axis``/``acc_axis``) in
+    :data:`SPEED_PARTS`."""
+    return tuple(f"{field_name}[{axis}]" for axis in axes)
+
+
+ALL_AXES = tuple(range(1, len(AXES) + 1))
+VEL_AXIS_PARTS = axis_parts("vel_axis", ALL_AXES)
+ACC_AXIS_PARTS = axis_parts("acc_axis", ALL_AXES)
+PATH_SPEED_PARTS = ("vel_cp", "acc_cp", "acc_ori")
+SPEED_PARTS: dict[str, str] = {
+    "vel_cp": "$VEL.CP",
+    "acc_cp": "$ACC.CP",
+    "acc_ori": "$ACC.ORI1",
+    **{key: f"$VEL_AXIS[{n}]" for n, key in zip(ALL_AXES, VEL_AXIS_PARTS, strict=True)},
+    **{key: f"$ACC_AXIS[{n}]" for n, key in zip(ALL_AXES, ACC_AXIS_PARTS, strict=True)},
+}
+"""The parts of the speed (:class:`olp.ir.Speed`, ``vel_axis``, ``acc_axis``) that are held
+apart (keys of ``ambiguous`` besides the fields of :class:`State`) -> their system variable.
+One set from a run-time value is :class:`Held` alone and settled only by setting that part
+again: the state's ``speed`` is one object, so a change to it (``$ACC.CP = 2``) cannot tell
+which part the program knows again. A PTP runs with the axis parts, a LIN or CIRC with the path
+parts (:data:`PATH_SPEED_PARTS`)."""
+RUNTIME_HOLDS: dict[str, tuple[str, ...]] = {
+    "$VEL.CP": ("vel_cp",),
+    "$ACC.CP": ("acc_cp",),
+    "$ACC.ORI1": ("acc_ori",),
+    "$APO.CDIS": ("cdis_mm",),
+    "$ORI_TYPE": ("ori_type",),
+    "$CIRC_TYPE": ("circ_type",),
+}
+"""What an assignment of a motion setting olp models holds when its value is known only at run
+time (keys of ``ambiguous``); ``$VEL_AXIS[n]``/``$ACC_AXIS[n]``, ``$TOOL`` and ``$BASE`` are held
+by their setters (:meth:`Core._set_axis_percent`, :meth:`Core._frame_at_run_time`)."""
 
 
 @dataclass(slots=True)
@@ -725,19 +766,77 @@ class Core:
         else:
             self._keep(stmt, reason)
 
+    # ---- motion settings set from run-time values
+    def _at_run_time(self, value: Expr) -> Unknown | None:
+        """The value of a motion setting's assignment where it is known only when the program
+        runs (a parameter, a name no file olp read declares, an expression of such) and olp can
+        keep the assignment as written, else None (then the setter's error stands: a name
+        declared nowhere olp looked; a WITH item, which only that motion runs with)."""
+        if self.in_with or getattr(self, "ambiguous", None) is None:
+            return None
+        known = self._value(value)
+        if not (isinstance(known, Unknown) and self._runtime(known)):
+            return None
+        lookup = self.variables.lookup
+        read = (lookup(v.name.upper()) for v in variables_read(value))
+        if isinstance(known, Counter) or any(isinstance(v, Counter) for v in read):
+            return None  # the loop is unrolled instead: each pass's value is known
+        return known
+
+    def _keep_at_run_time(
+        self, stmt: Stmt, name: str, known: Unknown, holds: Sequence[str]
+    ) -> None:
+        """Keep ``stmt``, which sets the motion setting ``name`` from a run-time value, as
+        written (not KRL-only: it changes how the robot moves, so another post refuses it) and
+        hold ``holds`` (:class:`Held`): a motion that runs with them before the program sets
+        them again runs with the controller's settings, as the source's does."""
+        self._keep(stmt, f"{name} is set from a value known only at run time ({known.reason})")
+        self._hold(holds, _held(name, stmt, known))
+
+    def _hold(self, keys: Sequence[str], why: Held) -> None:
+        ambiguous: dict[str, str] | None = getattr(self, "ambiguous", None)
+        if ambiguous is not None:
+            ambiguous.update(dict.fromkeys(keys, why))
+
+    def call_holds(self) -> tuple[str, ...]:
+        """The parts of the speed (:data:`SPEED_PARTS`) a call of a routine olp did not read
+        holds: all but an acceleration olp leaves to the controller (None in
+        :class:`olp.ir.Speed`), which the posts never write, so the controller's value holds
+        in the output as in the source."""
+        speed = self.state.speed
+        optional = {"acc_cp": speed.linear_acceleration, "acc_ori": speed.angular_acceleration}
+        return tuple(key for key in SPEED_PARTS if optional.get(key, 0.0) is not None)
+
     def _set_vel_cp(self, name: str, value: Expr, stmt: Stmt) -> None:
-        self._vel_cp(self._number(value, "$VEL.CP (m/s)"), value.span)
+        if not self._runtime_setting(name, value, stmt):
+            self._vel_cp(self._number(value, "$VEL.CP (m/s)"), value.span)
+
+    def _runtime_setting(self, name: str, value: Expr, stmt: Stmt) -> bool:
+        """Whether ``stmt`` sets ``name`` (:data:`RUNTIME_HOLDS`) from a run-time value, kept
+        as written (:meth:`_keep_at_run_time`); a member of ``$VEL = {...}`` is the whole
+        statement's (:meth:`_set_struct`)."""
+        known = self._at_run_time(value)
+        if known is None:
+            return False
+        if isinstance(stmt, Assign) and stmt.target.key == name:
+            self._keep_at_run_time(stmt, name, known, RUNTIME_HOLDS[name])
+        else:
+            self._hold(RUNTIME_HOLDS[name], _held(name, stmt, known))
+        return True
 
     def _vel_cp(self, speed: float, span: ir.SourceSpan) -> None:
         if speed <= 0:
             raise self._error(f"$VEL.CP (m/s) must be > 0, found {speed:g}", span)
         new_speed = dataclasses.replace(self.state.speed, linear=speed)
         self.state = dataclasses.replace(self.state, speed=new_speed, vel_cp_set=True)
+        self._settled("vel_cp")
 
     def _set_acc_cp(self, name: str, value: Expr, stmt: Stmt) -> None:
         """``$ACC.CP`` (m/s²): the TCP path acceleration of LIN and CIRC motions (KUKA system
         variables: "path acceleration", in m/s²; medium confidence on the unit from the KSS
         documentation as cited in vendor notes and forum threads, e.g. a KSS default of 2.3)."""
+        if self._runtime_setting(name, value, stmt):
+            return
         accel = self._number(value, "$ACC.CP (m/s²)")
         if accel <= 0:
             raise self._error(f"$ACC.CP (m/s²) must be > 0, found {accel:g}", value.span)
@@ -746,6 +845,8 @@ class Core:
     def _set_acc_ori1(self, name: str, value: Expr, stmt: Stmt) -> None:
         """``$ACC.ORI1`` (deg/s²): the TCP's swivel (orientation) acceleration; olp's
         orientation acceleration limit, in rad/s²."""
+        if self._runtime_setting(name, value, stmt):
+            return
         accel = self._number(value, "$ACC.ORI1 (deg/s²)")
         if accel <= 0:
             raise self._error(f"$ACC.ORI1 (deg/s²) must be > 0, found {accel:g}", value.span)
@@ -754,8 +855,12 @@ class Core:
     def _set_speed(self, **changes: float) -> None:
         speed = dataclasses.replace(self.state.speed, **changes)
         self.state = dataclasses.replace(self.state, speed=speed)
+        for change in changes:
+            self._settled(_SPEED_FIELD_PARTS[change])
 
     def _set_apo_cdis(self, name: str, value: Expr, stmt: Stmt) -> None:
+        if self._runtime_setting(name, value, stmt):
+            return
         self._cdis(self._number(value, "$APO.CDIS (mm)"), value.span, "$APO.CDIS (mm)")
 
     def _cdis(self, distance: float, span: ir.SourceSpan, what: str) -> None:
@@ -770,6 +875,14 @@ class Core:
         with components olp does not model is also kept as written, so none is lost."""
         if not isinstance(value, Aggregate):
             raise self._error(f"{name} must be set from an aggregate {{...}} here", value.span)
+        runtime = [
+            f"{name}.{m.name.upper()}"
+            for m in value.members
+            if f"{name}.{m.name.upper()}" in RUNTIME_HOLDS and self._at_run_time(m.value)
+        ]
+        if runtime:  # kept whole; each member set again below: the run-time ones held
+            listed = ", ".join(runtime)
+            self._keep(stmt, f"{listed} set from values known only at run time")
         unused = []
         for member in value.members:
             component = f"{name}.{member.name.upper()}"
@@ -778,7 +891,7 @@ class Core:
                 unused.append(member.name.upper())
             else:
                 setter(component, member.value, stmt)
-        if unused:
+        if unused and not runtime:
             listed = ", ".join(unused)
             if name in KEPT_SYSTEM_VARIABLES:
                 self._keep(stmt, f"{name} component(s) {listed} not modelled: kept as written")
@@ -788,6 +901,15 @@ class Core:
     def _set_axis_percent(self, key: str, value: Expr, stmt: Stmt) -> None:
         assert isinstance(stmt, Assign)
         name = key.removesuffix("[]")
+        known = self._at_run_time(value)
+        axes = None if known is None else self._runtime_axes(stmt.target, name)
+        if known is not None and axes is not None:
+            parts = axis_parts(_AXIS_FIELDS[name], axes)
+            if parts:
+                self._keep_at_run_time(stmt, f"{name}[]" if len(axes) > 1 else name, known, parts)
+            else:
+                self._ignore(stmt, f"{name} of external axes is not lowered")
+            return
         axis = self._single_index(stmt.target, name)
         percent = self._percent(value, f"{name}[{axis}]")
         if axis > len(AXES):
@@ -795,7 +917,24 @@ class Core:
             return
         self._set_axes_percent(name, {axis: percent})
 
+    def _runtime_axes(self, target: Var, name: str) -> tuple[int, ...] | None:
+        """The robot axes ``$VEL_AXIS[n]`` (``$ACC_AXIS[n]``) set from a run-time value sets:
+        ``n``'s (none for an external axis), all where ``n`` is known only at run time; None
+        where the index is not one number (the usual error)."""
+        index = target.selectors[0]
+        if not isinstance(index, Index) or len(index.args) != 1 or index.args[0] is None:
+            return None
+        number = self._value(index.args[0])
+        if self._runtime(number):
+            return ALL_AXES
+        axis = as_int(number)
+        if axis is None or axis < 1:
+            return None
+        return (axis,) if axis in ALL_AXES else ()
+
     def _set_axes_percent(self, name: str, percents: dict[int, float]) -> None:
+        for part in axis_parts(_AXIS_FIELDS[name], sorted(percents)):
+            self._settled(part)
         if name == "$VEL_AXIS":
             vel_axis = {**self.state.vel_axis, **percents}
             speed = dataclasses.replace(self.state.speed, joint=min(vel_axis.values()) / 100)
@@ -856,9 +995,13 @@ class Core:
         self._ipo_mode(self._value(value), value.span)
 
     def _set_ori_type(self, name: str, value: Expr, stmt: Stmt) -> None:
+        if self._runtime_setting(name, value, stmt):
+            return
         self._orientation_type("$ORI_TYPE", self._value(value), value.span)
 
     def _set_circ_type(self, name: str, value: Expr, stmt: Stmt) -> None:
+        if self._runtime_setting(name, value, stmt):
+            return
         self._orientation_type("$CIRC_TYPE", self._value(value), value.span)
 
     def _orientation_type(self, name: str, value: Value, span: ir.SourceSpan) -> None:
@@ -902,23 +1045,23 @@ class Core:
         """``$BASE = PalletBase[nActive].Base`` with a value known only when the program runs
         (a name no file olp read declares, a parameter, ...): kept as written (the KRL post
         writes it back; the first motion after a kept line gets all its settings written
-        again), and the base (tool) is unknown until the program sets it again: a motion
-        before that is an error (``ambiguous``, as after a BAS with run-time values), since
-        olp can check nothing of where it goes. In a WITH the error stands (returns False)."""
-        ambiguous: dict[str, str] | None = getattr(self, "ambiguous", None)
-        if self.in_with or ambiguous is None:
+        again), and the base (tool) is held (:class:`Held`) until the program sets it again:
+        a motion before that runs with the controller's settings, unchecked, as after a BAS
+        with run-time values. So is ``$BASE = BASE_DATA[nBase]`` with a run-time number. In a
+        WITH the error stands (returns False)."""
+        if isinstance(value, Var) and value.key == f"{_DATA_TABLES[name]}[]":
+            selector = value.selectors[0]  # BASE_DATA[nBase]: the number's value decides
+            args = selector.args if isinstance(selector, Index) else ()
+            if len(args) != 1 or args[0] is None:
+                return False  # the usual error (_frame_value)
+            value = args[0]
+        elif isinstance(value, Var) and value.key == "$NULLFRAME":
             return False
-        if isinstance(value, Var) and value.key in (f"{_DATA_TABLES[name]}[]", "$NULLFRAME"):
-            return False  # read by _frame_value
-        known = self._value(value)
-        if not self._runtime(known):
+        known = self._at_run_time(value)
+        if known is None:
             return False
-        assert isinstance(known, Unknown) and isinstance(stmt, Assign)
-        self._keep(stmt, f"{name} is set from a value known only at run time ({known.reason})")
-        ambiguous[setting] = Held(
-            f"{name} is set at line {stmt.span.line} from a value olp does not know "
-            f"({known.reason})"
-        )
+        assert isinstance(stmt, Assign)
+        self._keep_at_run_time(stmt, name, known, (setting,))
         self.track.lose_cartesian(f"{name} was set at run time at line {stmt.span.line}")
         return True
 
@@ -1035,6 +1178,18 @@ class Core:
                 raise self._error(f"{what} {member.name!r} is given twice", member.span)
             members[key] = member.value
         return members
+
+
+_AXIS_FIELDS = {"$VEL_AXIS": "vel_axis", "$ACC_AXIS": "acc_axis"}
+_SPEED_FIELD_PARTS = {"linear_acceleration": "acc_cp", "angular_acceleration": "acc_ori"}
+"""The part (:data:`SPEED_PARTS`) each field of :class:`olp.ir.Speed` that
+:meth:`Core._set_speed` sets is."""
+
+
+def _held(name: str, stmt: Stmt, known: Unknown) -> Held:
+    return Held(
+        f"{name} is set at line {stmt.span.line} from a value olp does not know ({known.reason})"
+    )
 
 
 def element_span(element: Value, default: ir.SourceSpan) -> ir.SourceSpan:

@@ -17,7 +17,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import operator
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from typing import TypeAlias
 
@@ -84,6 +84,15 @@ class Unknown:
     missing: bool = False
 
 
+@dataclass(frozen=True, slots=True)
+class Counter(Unknown):
+    """The counter of a FOR loop with constant bounds while olp tries its body with the counter
+    unknown (:meth:`olp.frontends.krl.lower._Lowering._lowers_as_block`): not a value of the
+    run, since unrolling the loop knows it. A motion setting computed from it is not kept as a
+    run-time one (:meth:`olp.frontends.krl.state.Core._at_run_time`): the loop is unrolled and
+    each pass's setting known."""
+
+
 Const: TypeAlias = Num | Bool | Text | Bits | EnumValue | Aggregate | ArrayValue | Signal
 Value: TypeAlias = Const | Unknown
 
@@ -93,6 +102,27 @@ def is_axis_aggregate(agg: Aggregate) -> bool:
     if agg.type_name is not None:
         return agg.type_name.upper() in AXIS_TYPES
     return any(m.name.upper() in AXES for m in agg.members)
+
+
+def variables_read(expr: Expr | None) -> Iterator[Var]:
+    """Each variable ``expr`` reads, index expressions included."""
+    if isinstance(expr, Var):
+        yield expr
+        for selector in expr.selectors:
+            if isinstance(selector, Index):
+                for arg in selector.args:
+                    yield from variables_read(arg)
+    elif isinstance(expr, FuncCall):
+        for arg in expr.args:
+            yield from variables_read(arg)
+    elif isinstance(expr, Aggregate):
+        for member in expr.members:
+            yield from variables_read(member.value)
+    elif isinstance(expr, Unary):
+        yield from variables_read(expr.operand)
+    elif isinstance(expr, Binary):
+        yield from variables_read(expr.left)
+        yield from variables_read(expr.right)
 
 
 def with_type(value: Const, type_name: str) -> Const:
