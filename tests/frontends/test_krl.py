@@ -422,7 +422,15 @@ def test_error_location_and_text(line: str, column: int, found: str) -> None:
 
 
 def test_motion_settings_that_differ_between_paths_are_an_error_at_the_motion() -> None:
-    error = parse_error("IF $IN[1] THEN", "  $VEL.CP = 0.5", "ENDIF", f"LIN {FULL}")
+    """Where a path's value cannot be put on the controller (set in a routine olp inlined and
+    wrote out already, no motion of which runs with it), the speed after the join is neither
+    known nor the controller's: the motion that runs with it stops the reading. (A path that
+    ends with the setting keeps it as written and the speed is the controller's:
+    tests/frontends/test_krl_joins.py.)"""
+    text = program("IF $IN[1] THEN", "  Slow( )", "ENDIF", f"LIN {FULL}")
+    with pytest.raises(ParseError) as info:
+        parse_krl(text + "DEF Slow( )\n  $VEL.CP = 0.5\nEND\n", "t.src")
+    error = info.value
     assert error.span is not None and (error.span.line, error.span.column) == (5, 1)
     assert "the speed differs between the paths of the IF at line 2" in error.message
     settled = parse("IF $IN[1] THEN", "  $VEL.CP = 0.5", "ENDIF", "$VEL.CP = 0.2", f"LIN {FULL}")

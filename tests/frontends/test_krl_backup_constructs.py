@@ -167,20 +167,21 @@ END
 """
 
 
-def test_settings_no_motion_runs_with_are_a_warning_not_a_silent_drop(
-    station: object, tmp_path: Path
-) -> None:
+def test_settings_no_motion_runs_with_are_kept_not_dropped(station: object, tmp_path: Path) -> None:
     src = tmp_path / "ToolSetup.src"
     src.write_text(TOOL_SETUP_MODULE, encoding="latin-1")
     result = olp.build(station, src, post="kuka", collisions=None)  # type: ignore[arg-type]
     lost = [d for d in result.diagnostics if "no motion of the program runs with" in d.message]
-    # the settings before the LIN are written with it; the one after it is kept as written
-    # (it is the module's effect on its caller); the one inside the IF, a block olp lowered
-    # already, is not in the output, with a warning
-    assert [(d.severity, d.span.line) for d in lost] == [("warning", 10)]
+    # the settings before the LIN are written with it; the ones after it are kept as written
+    # (they are the module's effect on its caller), the one inside the IF in its path (kept
+    # at the IF's end: it used to be left out with a warning, as the IF was lowered already)
+    assert lost == []
     nodes = list(result.compiled.program)
     lin = next(i for i, node in enumerate(nodes) if isinstance(node, ir.LinearMove))
     after = [n for n in nodes[lin + 1 :] if isinstance(n, ir.Verbatim)]
     assert [(n.text, n.native_only, n.span.line) for n in after] == [
-        ("$BASE = $NULLFRAME", True, 8)
+        ("$BASE = $NULLFRAME", True, 8),
+        ("$TOOL = $NULLFRAME", True, 10),
     ]
+    (block,) = [n for n in result.compiled.program.instructions if isinstance(n, ir.If)]
+    assert [n.span.line for n in block.branches[0].body] == [10]

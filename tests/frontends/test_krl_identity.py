@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 import olp
-from olp.errors import ParseError
+from olp import ir
 from olp.frontends.bundled import KrlOptions
 from olp.frontends.krl import load_krl
 from olp.ir_flow import leaves_and_blocks
@@ -118,14 +118,23 @@ END
 """
 
 
-def test_a_c_dis_motion_still_needs_a_known_distance(tmp_path: Path) -> None:
-    """Paths that disagree on ``$APO.CDIS``: the exact stop after them runs, the next motion
-    that approximates with it stops the reading at its line."""
+def test_a_c_dis_motion_after_paths_that_disagree_runs_with_the_controllers_distance(
+    tmp_path: Path,
+) -> None:
+    """Paths that disagree on ``$APO.CDIS`` (each keeps its line as written): the exact stop
+    after them runs with olp's settings, the next motion that approximates with it runs with
+    the distance the controller holds (it used to stop the reading at its line: the program is
+    valid, and the controller approximates with whichever the path set)."""
     path = tmp_path / "cell.src"
     path.write_text(BRANCHED_CDIS)
-    with pytest.raises(ParseError, match=r"\$APO.CDIS differs between the paths") as info:
-        load_krl(path)
-    assert info.value.span is not None and info.value.span.line == 12
+    program = load_krl(path).program
+    nodes = list(leaves_and_blocks(program.instructions))
+    kept = [(n.text, n.span.line) for n in nodes if isinstance(n, ir.Verbatim)]
+    assert kept == [("$APO.CDIS = 5", 7), ("$APO.CDIS = 10", 9)]
+    exact, approximated = nodes[-2:]
+    assert isinstance(exact, ir.LinearMove) and exact.span.line == 11
+    assert isinstance(approximated, ir.RuntimeMove) and approximated.controller_settings
+    assert approximated.span.line == 12 and "$APO.CDIS differs" in approximated.reason
 
 
 # --------------------------------------------------------------------------------------------

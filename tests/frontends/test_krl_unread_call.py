@@ -136,17 +136,38 @@ def test_a_call_of_the_modules_own_routine_holds_nothing(tmp_path: Path) -> None
     assert not [d for d in result.diagnostics if d.kind == "unknown_start"]
 
 
-def test_a_setting_in_a_block_before_an_unread_call_is_an_error(tmp_path: Path) -> None:
+def test_a_setting_in_a_block_before_an_unread_call_is_kept_in_its_path(tmp_path: Path) -> None:
     """``$VEL.CP`` set inside an IF with no motion in it, then a call of an unread routine:
-    olp writes settings only before its motions, and the motion after the call runs with the
-    controller's settings, so on that path the setting would never reach the controller; a
-    located error, not a silent drop."""
+    olp writes settings only before its motions, and the call runs with the controller's, so
+    the setting is kept as written at the end of its path (it used to be a located error: the
+    IF was lowered already when the call came)."""
     text = CELL.replace(
         "SetFrames(1, 2)\n", "IF $IN[1] THEN\n$VEL.CP = 0.1\nENDIF\nSetFrames(1, 2)\n"
     )
-    with pytest.raises(ParseError, match="inside a block no motion of which runs with them") as err:
+    result = _build(tmp_path, text)
+    assert result.ok, [d.format() for d in result.diagnostics]
+    lines = _written(result)
+    call = lines.index("SetFrames(1, 2)")
+    assert lines[call - 4 : call + 1] == [
+        "$VEL.CP = 0.2",
+        "IF $IN[1] THEN",
+        "$VEL.CP = 0.1",
+        "ENDIF",
+        "SetFrames(1, 2)",
+    ]
+
+
+def test_a_setting_a_called_routine_ends_with_before_an_unread_call_is_an_error(
+    tmp_path: Path,
+) -> None:
+    """A routine of the module that only sets ``$VEL.CP``, then a call of an unread routine:
+    the routine's body is lowered already, so olp cannot keep the setting where the call needs
+    it; a located error, not a silent drop."""
+    text = CELL.replace("SetFrames(1, 2)\n", "Slow( )\nSetFrames(1, 2)\n")
+    text += "DEF Slow( )\n$VEL.CP = 0.1\nEND\n"
+    with pytest.raises(ParseError, match="no motion of which runs with them") as err:
         _build(tmp_path, text)
-    assert err.value.span is not None and err.value.span.line == 6
+    assert err.value.span is not None and err.value.span.line == 12
 
 
 APPROXIMATED = """DEF cell( )

@@ -90,6 +90,7 @@ from olp.frontends.krl.values import (
     Variables,
     as_int,
 )
+from olp.frontends.krl.written import FIELD_KEYS, PART_KEYS, named_keys, set_keys, written_keys
 from olp.ir_flow import leaves
 
 __all__ = ["DEFAULT_VEL_CP", "KrlResult", "lower_module"]
@@ -170,7 +171,15 @@ class _Lowering(Motions, Events):
         self.past: set[str] = set()  # counters of unrolled FOR loops (see flow.PastFor)
         # statements that set motion settings (absorbed into the motions) since the last motion
         self.unwritten: list[Stmt] = []
-        self.unwritten_at: list[tuple[list[Any], int]] = []  # each one's output list, position
+        # each one's output list, position and the setting keys it set (olp.frontends.krl.written)
+        self.unwritten_at: list[tuple[list[Any], int, frozenset[str]]] = []
+        # setting keys whose value on this path the output may not have put on the controller,
+        # with no statement left to keep for them (see olp.frontends.krl.written)
+        self.lost: set[str] = set()
+        # absorbed statements a motion passed that wrote none of what they set (``$VEL.CP``
+        # before a PTP): still keepable where they stand, for what runs with the controller's
+        # settings (each: the statement, its output list, position and keys)
+        self.deferred: list[tuple[Stmt, tuple[list[Any], int, frozenset[str]]]] = []
         self.reports = 0  # lines reported as left out by this lowering (once each or not)
         # FOR loops kept as written since the last motion: output list, first and end position
         self.settings_loops: list[tuple[list[Any], int, int]] = []
@@ -231,9 +240,9 @@ class _Lowering(Motions, Events):
             self._comment(stmt)
             return
         if isinstance(stmt, LinRows):  # checks and spends per row itself
+            start = len(self.out)
             self._lin_rows(stmt)
-            self.unwritten.clear()
-            self.unwritten_at.clear()
+            self._moved(self.out[start:])
             return
         if self.returned is not None:
             routine, line = self.returned
@@ -249,6 +258,8 @@ class _Lowering(Motions, Events):
         if self.ambiguous and isinstance(stmt, MotionStmt | FastMotion):
             motion = materialise(stmt) if isinstance(stmt, FastMotion) else stmt
             unsettled = self._unsettled(motion)
+            if unsettled and all(isinstance(why, Held) for why in unsettled.values()):
+                self._check_written_for_controller(motion, unsettled)
             if unsettled and self._controller_settings_motion(motion, unsettled):
                 self.ctx.spend(stmt)
                 return
@@ -266,13 +277,42 @@ class _Lowering(Motions, Events):
             return
         past = self._past_counters(stmt)
         start, reported = len(self.out), len(self.ignored)
+        before = self.state, dict(self.ambiguous)
         try:
             self._statements[type(stmt)](stmt)
         except ir.IRError as exc:
             raise self._error(f"invalid value: {exc}", stmt.span) from None
         if past:
             self._no_read_past_for(past, start, stmt)
-        self._track_settings(stmt, self.out[start:], len(self.ignored) > reported)
+        self._track_settings(stmt, self.out[start:], len(self.ignored) > reported, before)
+
+    def _check_written_for_controller(self, motion: MotionStmt, unsettled: dict[str, str]) -> None:
+        """A motion with the controller's settings (the output writes none before it) also
+        runs with the ones olp knows: each must be on the controller. One olp absorbed and
+        wrote only where a motion used it, which no motion of this kind has since
+        (``$ORI_TYPE = #CONSTANT`` before a PTP: the output writes it before a CIRC only), is
+        not: an error, not a motion run with another value. An approximated one's distance is
+        one of them (the motion keeps its C_DIS: :attr:`olp.ir.RuntimeMove.approximated`)."""
+        joint = motion.keyword.upper().startswith(("PTP", "SPTP"))
+        names = []
+        # (the parts of the speed held apart are the speed's and the axis settings' keys)
+        for name in sorted(self._used_settings(motion) - set(unsettled) - set(PART_KEYS)):
+            keys = FIELD_KEYS[name]
+            if name == "speed":
+                keys = frozenset({"speed.joint" if joint else "speed.linear"})
+            if keys & self.unkeepable():
+                names.append(_SETTING_NAMES[name])
+        if names:
+            listed = ", ".join(names)
+            reasons = "; ".join(sorted(set(unsettled.values())))
+            raise self._error(
+                f"this motion runs with the settings the controller holds ({reasons}), and "
+                f"with {listed} as the program set it, which the output has not written "
+                "since (olp writes a setting only before a motion that uses it): the "
+                "controller would not hold it here",
+                motion.span,
+                hint=f"set {listed} again before the motion",
+            )
 
     def _comment(self, stmt: CommentStmt) -> None:
         """A source comment, as :class:`olp.ir.Comment` (a fold line as such); the folds open
@@ -321,18 +361,51 @@ class _Lowering(Motions, Events):
                     "value before reading it",
                 )
 
-    def _track_settings(self, stmt: Stmt, new: Sequence[Any], reported: bool) -> None:
+    def _track_settings(
+        self, stmt: Stmt, new: Sequence[Any], reported: bool, before: tuple[State, dict[str, str]]
+    ) -> None:
         """Note an assignment or call that left nothing in the program and was not reported:
         one olp absorbed into the motion settings (``$BASE``, ``$VEL.CP``, ``BAS``,
         ``PDAT_ACT``, ...). The posts write settings before the motions that run with them, so
-        one that no motion follows is not in the output (:meth:`report_unwritten_settings`)."""
+        one that no motion follows is not in the output (:meth:`report_unwritten_settings`).
+
+        Also which setting keys are on the controller on this path (``lost``, :mod:`olp.
+        frontends.krl.written`). A block's paths and an unrolled FOR's statements were tracked
+        one by one (the block's join makes the union: :meth:`_join`); so was an inlined call's
+        body, whose motions already wrote what they write."""
+        if isinstance(stmt, Block | ForLoop):
+            return
+        inlined = any(isinstance(n, PendingCall) for n in new)
         if moves(new) or any(isinstance(n, Pending | PendingRows) for n in leaves(new)):
-            self.unwritten.clear()
-            self.unwritten_at.clear()
+            self._moved(() if inlined else new)
             self._settings_loops_modelled()
         elif isinstance(stmt, Assign | CallStmt) and not new and not reported:
+            keys = set_keys(*before, self.state, self.ambiguous) | named_keys(stmt)
+            self.lost -= keys
             self.unwritten.append(stmt)
-            self.unwritten_at.append((self.out, len(self.out)))
+            self.unwritten_at.append((self.out, len(self.out), frozenset(keys)))
+        elif not inlined:
+            # written as it stands (a BAS with run-time values, ...): the controller holds what
+            # it sets; set and left out (with a warning): that part never reaches it
+            keys = set_keys(*before, self.state, self.ambiguous)
+            self.lost = self.lost - keys if new else self.lost | keys
+
+    def _moved(self, new: Sequence[Any]) -> None:
+        """A motion ran (``new``: the motions, empty for an inlined call's): the settings it
+        does not write whose statements wait (``unwritten``) are lost from here on, except
+        those of a statement that sets nothing the motion writes: it can still be kept where
+        it stands (``deferred``: no motion since relies on the output's writing what it sets),
+        until a motion writes some of that."""
+        wrote = written_keys(new, self.state)
+        self.deferred = [d for d in self.deferred if not d[1][2] & wrote]
+        for stmt, position in zip(self.unwritten, self.unwritten_at, strict=True):
+            if position[2] & wrote:
+                self.lost |= position[2] - wrote
+            elif position[2]:  # (one that sets no setting, PDAT_ACT = ..., goes as before)
+                self.deferred.append((stmt, position))
+        self.lost -= wrote
+        self.unwritten.clear()
+        self.unwritten_at.clear()
 
     def _ignore(self, stmt: Stmt | Assign, reason: str) -> None:
         """Report ``stmt`` as left out (once per line and reason), and count the report even
@@ -352,12 +425,18 @@ class _Lowering(Motions, Events):
                         out[k] = dataclasses.replace(out[k], modelled=True)
         self.settings_loops.clear()
 
-    def _keep_unwritten(self, reason: str, strict: bool = True) -> None:
+    def _keep_unwritten(
+        self,
+        reason: str,
+        strict: bool = True,
+        only: list[Any] | None = None,
+        deferred: bool | None = None,
+    ) -> None:
         """What comes next runs with the controller's settings: the FOR loops kept since the
         last motion keep their lines' warning for other posts (see
         :meth:`_keep_settings_loop`); the statements olp absorbed are kept as written."""
         self.settings_loops.clear()
-        super()._keep_unwritten(reason, strict)
+        super()._keep_unwritten(reason, strict, only, deferred)
 
     def report_unwritten_settings(self) -> None:
         """The settings no motion of the program follows (a routine that sets ``$BASE`` and
@@ -375,8 +454,7 @@ class _Lowering(Motions, Events):
                 "sets motion settings no motion of the program runs with: olp writes settings "
                 "only before the motions that use them, so this one is not in the output",
             )
-        self.unwritten.clear()
-        self.unwritten_at.clear()
+        self._moved(())
 
     # ---- motions to where the robot is
     def _motion_or_here(self, stmt: MotionStmt) -> None:
@@ -490,6 +568,7 @@ class _Lowering(Motions, Events):
         for name in _STATE_FIELDS:
             self.ambiguous[name] = why
         self._hold(self.call_holds(), why)
+        self.lost.clear()  # the controller holds what the routine left, on every path
         self.track.lose(RuntimeStart(f"{why}, which may move the robot"))
         args = tuple("" if arg is None else self.sources.snippet(arg.span) for arg in stmt.args)
         self.out.append(ir.Call(name=stmt.name, args=args, may_move=True, span=stmt.span))
@@ -874,9 +953,9 @@ class _Lowering(Motions, Events):
 
     def _if(self, stmt: Block) -> None:
         condition = self._expr(stmt.conditions[0])
-        arms = [self._branch(body) for body in stmt.bodies]
-        self._join([child for child, _ in arms], "IF", stmt.span)
-        (_, then_body), (_, else_body) = arms
+        paths = [self._path(body) for body in stmt.bodies]
+        self._join(paths, "IF", stmt.span)
+        then_body, else_body = (build_instructions(p.out, dense=False) for p in paths)
         branch = ir.Branch(condition=condition, body=then_body, span=stmt.span)
         self.out.append(
             ir.If(branches=(branch,), orelse=else_body, has_else=stmt.has_else, span=stmt.span)
@@ -884,13 +963,14 @@ class _Lowering(Motions, Events):
 
     def _switch(self, stmt: Block) -> None:
         subject = self._expr(stmt.conditions[0])
-        arms = [self._branch(body) for body in stmt.bodies]
-        self._join([child for child, _ in arms], "SWITCH", stmt.span)
+        paths = [self._path(body) for body in stmt.bodies]
+        self._join(paths, "SWITCH", stmt.span)
+        bodies = [build_instructions(p.out, dense=False) for p in paths]
         cases = tuple(
             ir.Case(values=tuple(self._expr(v) for v in values), body=body, span=stmt.span)
-            for values, (_, body) in zip(stmt.cases, arms, strict=False)
+            for values, body in zip(stmt.cases, bodies, strict=False)
         )
-        default = arms[-1][1]
+        default = bodies[-1]
         self.out.append(
             ir.Switch(
                 subject=subject,
@@ -940,14 +1020,27 @@ class _Lowering(Motions, Events):
                 self.status_turn,
             )
             child._reported = self._reported
-            child.unwritten, child.unwritten_at = self.unwritten, self.unwritten_at
             child.settings_loops = self.settings_loops
+        child.lost = set(self.lost)
+        # each path its own list of the statements waiting for a motion (the join makes the
+        # union); a probe keeps none in the lists it is nested in: its copies point to a scratch
+        child.unwritten = list(self.unwritten)
+        if probe:
+            scratch: list[Any] = []
+            child.live_outs.append(scratch)
+            child.unwritten_at = [(scratch, 0, keys) for _, _, keys in self.unwritten_at]
+            child.deferred = [(stmt, (scratch, 0, p[2])) for stmt, p in self.deferred]
+        else:
+            child.unwritten_at = list(self.unwritten_at)
+            child.deferred = list(self.deferred)
         return child
 
-    def _branch(self, body: Sequence[Stmt], loop: bool = False) -> tuple[_Lowering, Body]:
+    def _path(self, body: Sequence[Stmt], loop: bool = False) -> _Lowering:
+        """A block's path lowered; its output stays a list until the block's join
+        (:meth:`_join`), which may keep statements in it."""
         child = self._child(loop)
         child.lower_body(body)
-        return child, build_instructions(child.out, dense=False)
+        return child
 
     def _loop_body(self, body: Sequence[Stmt], keyword: str, span: ir.SourceSpan) -> Body:
         """A loop's body, lowered once from the state every pass may start with: variables it
@@ -963,10 +1056,27 @@ class _Lowering(Motions, Events):
             value = joined([probe.variables.lookup(name)], reason)
             past = isinstance(value, PastFor)  # read past its unrolled FOR: an error stays one
             self.variables.assign(name, value if past else unset.get(name, value))
-        self._merge_states([self, probe], where)
-        child, lowered = self._branch(body, loop=True)
+        held = self._merge_states([self, probe], where, held=True)
+        self.lost |= probe.unkeepable()  # what a pass leaves unwritten, the next one starts with
+        child = self._path(body, loop=True)
         self._join([child], keyword, span, fallthrough=True)
-        return lowered
+        self._check_next_pass(child, held, where, span)
+        return build_instructions(child.out, dense=False)
+
+    def _check_next_pass(
+        self, child: _Lowering, held: set[str], where: str, span: ir.SourceSpan
+    ) -> None:
+        """The settings the loop's start takes as the controller's because a pass changes them
+        (``held``, decided on a probe of the body) must be on the controller at the end of the
+        pass lowered for the output too; else olp cannot keep its word (not met by any program
+        olp knows: the probe and the pass run the same statements)."""
+        for name in sorted(held):
+            if FIELD_KEYS[name] & child.unkeepable():
+                raise self._error(
+                    f"{_SETTING_NAMES[name]} differs between the passes of {where}, and olp "
+                    "cannot keep the statement that sets it for the next pass",
+                    span,
+                )
 
     def _set_by_earlier_pass(self, body: Sequence[Stmt], where: str) -> dict[str, Unknown]:
         """A variable without a value before a loop that the loop's body assigns: a pass may
@@ -998,7 +1108,13 @@ class _Lowering(Motions, Events):
         fallthrough: bool = False,
     ) -> None:
         """After a block: what every path reaching its end agrees on is known, the rest is not.
-        ``fallthrough``: the block may be skipped (a loop not entered)."""
+        ``fallthrough``: the block may be skipped (a loop not entered).
+
+        The statements a path absorbed into the motion settings after its last motion are kept
+        as written at its end, where they stand (for the KRL post: the output writes settings
+        only before the motions that use them, so on that path they would never reach the
+        controller; a setting that differs between the paths is the controller's after the
+        join, :meth:`_merge_states`). The paths' outputs are still lists here."""
         reached = [
             c for c in children if c.returned is None and c.exiting is None and c.jumped is None
         ]
@@ -1006,6 +1122,13 @@ class _Lowering(Motions, Events):
         where = f"the {keyword} at line {span.line}"
         if not reached:
             reached = list(children)
+        for child in children:
+            child._keep_unwritten(
+                f"sets motion settings after the last motion of its path through {where}: "
+                "kept as written, for what runs after the block",
+                strict=False,
+                only=child.out,
+            )
         base = self.variables
         changed = set().union(*(c.variables.changed_since(base) for c in reached if c is not self))
         for name in sorted(changed):
@@ -1019,23 +1142,126 @@ class _Lowering(Motions, Events):
             for name, absorbed in c.absorbed_data.items():
                 if self.absorbed_data.get(name) is not absorbed:
                     self.absorbed_data[name] = None
-        self._merge_states(reached, where)
+        self._merge_states(reached, where, held=True)
+        self._join_unwritten(reached)
 
-    def _merge_states(self, ends: Sequence[_Lowering], where: str) -> None:
-        """Motion settings and the position after paths ending in ``ends``."""
+    def _join_unwritten(self, ends: Sequence[_Lowering]) -> None:
+        """The statements waiting for a motion (and the deferred ones) after a join, once each,
+        in order, and the setting keys lost on any path. One from before the block that a
+        path's motion passed is not kept later (the output writes what that motion uses; the
+        rest of it is lost, as on that path); one left in an output already lowered (an inlined
+        routine's) stays, for the error at what would run without it
+        (:meth:`_keep_unwritten`); a deferred one left in a path's output is lost."""
+        self.lost = set().union(*(end.lost for end in ends))
+        waiting = self._union([list(zip(e.unwritten, e.unwritten_at, strict=True)) for e in ends])
+        self.unwritten[:] = [stmt for stmt, _ in waiting]
+        self.unwritten_at[:] = [position for _, position in waiting]
+        deferred = self._union([e.deferred for e in ends])
+        live = [*self.live_outs, self.out]
+        self.deferred = [d for d in deferred if any(d[1][0] is out for out in live)]
+        self.lost = self.lost.union(*(d[1][2] for d in deferred if d not in self.deferred))
+
+    def _union(
+        self, lists: Sequence[Sequence[tuple[Stmt, tuple[list[Any], int, frozenset[str]]]]]
+    ) -> list[tuple[Stmt, tuple[list[Any], int, frozenset[str]]]]:
+        counts: dict[tuple[int, int, int], int] = {}
+        entries = []
+        for found in lists:
+            for stmt, position in found:
+                key = (id(stmt), id(position[0]), position[1])
+                counts[key] = counts.get(key, 0) + 1
+                if counts[key] == 1:
+                    entries.append((key, stmt, position))
+        live = [*self.live_outs, self.out]
+        union = []
+        for key, stmt, position in entries:
+            out, at, keys = position
+            if any(out is o for o in live) and counts[key] < len(lists):
+                if not any(getattr(node, "span", None) == stmt.span for node in out[at:]):
+                    self.lost |= keys  # (else a path kept it where it stands: written)
+                continue
+            union.append((stmt, position))
+        return union
+
+    def unkeepable(self) -> set[str]:
+        """The setting keys whose value on this path the output may not put on the controller:
+        lost ones, and those of statements waiting in an output olp has already lowered (an
+        inlined routine's)."""
+        live = [*self.live_outs, self.out]
+        positions = [*self.unwritten_at, *(p for _, p in self.deferred)]
+        frozen = [keys for out, _, keys in positions if not any(out is o for o in live)]
+        return self.lost.union(*frozen)
+
+    def _merge_states(self, ends: Sequence[_Lowering], where: str, held: bool = False) -> set[str]:
+        """Motion settings and the position after paths ending in ``ends``.
+
+        A setting that differs between the paths is ambiguous. With ``held`` (a block's paths,
+        each lowered here, and a loop's start) it is the controller's
+        (:class:`~olp.frontends.krl.state.Held`: the controller holds whichever value the path
+        that ran set) where every path's value is on the controller: the output wrote it, or
+        keeps as written the statements that set it (the ones waiting for a motion, kept here),
+        or the program never set it. A motion that runs with it then runs with the
+        controller's settings (:meth:`~olp.frontends.krl.motion.Motions.
+        _controller_settings_motion`). Otherwise (a path's value olp absorbed and no output
+        writes, a jump's or a RETURN's paths) it stays an error at the motion that runs with it.
+        Returns the settings made the controller's here."""
         states = [e.state for e in ends]
         ambiguous: dict[str, str] = {}
         for e in ends:
-            ambiguous.update(e.ambiguous)
+            for name, why in e.ambiguous.items():
+                current = ambiguous.get(name)
+                if current is None or (isinstance(current, Held) and not isinstance(why, Held)):
+                    ambiguous[name] = why  # an error on one path stays one
+        if not held:  # (a jump's or a RETURN's paths: their waiting statements are not kept)
+            for e in ends:
+                if e is not self:
+                    positions = [*e.unwritten_at, *(p for _, p in e.deferred)]
+                    self.lost |= e.lost.union(*(keys for _, _, keys in positions))
+        made_held: set[str] = set()
         unset = set().union(*(e.unset for e in ends))
         for name in _STATE_FIELDS:
             values = [getattr(s, name) for s in states]
-            if any(v != values[0] for v in values[1:]):
-                ambiguous[name] = f"{_SETTING_NAMES[name]} differs between the paths of {where}"
+            if all(v == values[0] for v in values[1:]):
+                continue
+            setting = _SETTING_NAMES[name]
+            if held and self._held_at_join(ends, name, ambiguous):
+                ambiguous[name] = Held(
+                    f"{setting} differs between the paths of {where} (the controller holds "
+                    "the one its path set)"
+                )
+                made_held.add(name)
+            else:
+                ambiguous[name] = f"{setting} differs between the paths of {where}"
+        if made_held:
+            keys = set().union(*(FIELD_KEYS[n] for n in made_held))
+            for e in ends:
+                positions = [*e.unwritten_at, *(p for _, p in e.deferred)]
+                if keys & set().union(*(k for _, _, k in positions)):
+                    e._keep_unwritten(
+                        f"sets motion settings that differ between the paths of {where}: kept "
+                        "as written, as what runs after them runs with the controller's",
+                        strict=False,
+                        deferred=True,
+                    )
         vel_cp_set = all(s.vel_cp_set for s in states)
         self.state = dataclasses.replace(states[0], vel_cp_set=vel_cp_set)
         self.ambiguous = ambiguous
         self.unset = unset
+        self._merge_tracks(ends, where)
+        return made_held
+
+    @staticmethod
+    def _held_at_join(ends: Sequence[_Lowering], name: str, ambiguous: dict[str, str]) -> bool:
+        """Whether setting ``name``, which differs between the paths ``ends``, can be the
+        controller's after them: no path leaves it ambiguous for a reason other than
+        :class:`~olp.frontends.krl.state.Held`, and every path's value is on the controller or
+        can be put there (:meth:`unkeepable`)."""
+        if name in ambiguous and not isinstance(ambiguous[name], Held):
+            return False
+        return not any(FIELD_KEYS[name] & e.unkeepable() for e in ends)
+
+    def _merge_tracks(self, ends: Sequence[_Lowering], where: str) -> None:
+        """The position after paths ending in ``ends``."""
         tracks = [e.track for e in ends]
         if any(t != tracks[0] for t in tracks[1:]):
             self.track = dataclasses.replace(tracks[0])

@@ -387,11 +387,18 @@ class Motions(InlineForms):
         the motion's own WITH sets (a spline inline form's ``$TOOL = STOOL2(FP1)``, ...) is not
         ambiguous for it."""
         ambiguous: dict[str, str] = getattr(self, "ambiguous", {})
+        used = self._used_settings(stmt)
+        return {name: why for name, why in ambiguous.items() if name in used}
+
+    @staticmethod
+    def _used_settings(stmt: MotionStmt) -> frozenset[str]:
+        """The motion settings ``stmt`` runs with that its own WITH does not set
+        (:meth:`_unsettled`)."""
         base = _BASE_MOTION.get(stmt.keyword, "PTP")
         used = _USED_SETTINGS[base] | ({"cdis_mm"} if stmt.approx else set())
         for assignment in stmt.with_clause or ():
             used = used - _WITH_SETS.get((assignment.target.key, base == "PTP"), frozenset())
-        return {name: why for name, why in ambiguous.items() if name in used}
+        return used
 
     def _controller_settings_motion(self, stmt: MotionStmt, unsettled: dict[str, str]) -> bool:
         """A motion whose ambiguous settings (``unsettled``, :meth:`_unsettled`) are all held
@@ -469,7 +476,13 @@ class Motions(InlineForms):
         )
         return True
 
-    def _keep_unwritten(self, reason: str, strict: bool = True) -> None:
+    def _keep_unwritten(
+        self,
+        reason: str,
+        strict: bool = True,
+        only: list[Any] | None = None,
+        deferred: bool | None = None,
+    ) -> None:
         """Keep as written, where they stand and for the KRL post only
         (:attr:`olp.ir.Verbatim.native_only`), the statements olp absorbed into the motion
         settings since the last motion (``unwritten``): something that runs with the
@@ -480,12 +493,20 @@ class Motions(InlineForms):
         kept where it stands: with ``strict`` (a call or motion with the controller's settings
         comes next, which would run without it on that path) that is an error at it, else it
         is reported at the end (:meth:`report_unwritten_settings`). One a kept BAS already wrote
-        (a data record it reads) is not written twice."""
+        (a data record it reads) is not written twice. ``only``: keep just those in that output
+        list (a block's path at its join: :meth:`olp.frontends.krl.lower._Lowering._join`).
+
+        ``deferred`` (by default with ``strict``): the statements a motion passed that wrote
+        none of what they set (``$VEL.CP`` before a PTP, :mod:`olp.frontends.krl.written`) are
+        kept too, where they stand (after the others: they stand before them); one in an
+        output already lowered is lost (``lost``)."""
         unwritten: list[Any] = getattr(self, "unwritten", [])
-        positions: list[tuple[list[Any], int]] = getattr(self, "unwritten_at", [])
+        positions: list[tuple[list[Any], int, frozenset[str]]] = getattr(self, "unwritten_at", [])
         live = [*getattr(self, "live_outs", []), self.out]
         for k in range(len(unwritten) - 1, -1, -1):  # from the back: earlier positions hold
-            out, at = positions[k]
+            out, at, _ = positions[k]
+            if only is not None and out is not only:
+                continue
             if not any(out is candidate for candidate in live):
                 if strict:
                     raise self._error(
@@ -504,6 +525,19 @@ class Motions(InlineForms):
                 continue
             self._keep_krl_only(stmt, reason)
             out.insert(at, self.out.pop())
+        if strict if deferred is None else deferred:
+            self._keep_deferred(reason, live)
+
+    def _keep_deferred(self, reason: str, live: list[list[Any]]) -> None:
+        waiting: list[Any] = getattr(self, "deferred", [])
+        lost: set[str] = getattr(self, "lost", set())
+        for stmt, (out, at, keys) in reversed(waiting):
+            if not any(out is candidate for candidate in live):
+                lost |= keys
+            elif not any(getattr(node, "span", None) == stmt.span for node in out[at:]):
+                self._keep_krl_only(stmt, reason)
+                out.insert(at, self.out.pop())
+        waiting.clear()
 
     def _keep_runtime_motion(self, stmt: MotionStmt, base: str, reason: str) -> None:
         """Keep a _REL motion by run-time offsets as written (:class:`~olp.ir.Verbatim`, with a
