@@ -217,3 +217,42 @@ def test_the_krl_post_writes_only_krls_approximation_words() -> None:
     assert krl_approximation(("c_ptp", "C_DIS")) == " C_PTP C_DIS"
     with pytest.raises(PostError, match="C_FAST"):
         krl_approximation(("C_FAST",))
+
+
+def _distance_program(first_approximates: bool) -> str:
+    """``BAS(#PTP_DAT)`` sets the axis speeds and the approximation distance; the PTP after it
+    writes the speeds and, where it approximates, ``$APO.CDIS`` too (else the BAS's distance
+    never reaches the controller: the BAS is absorbed)."""
+    first = " C_DIS" if first_approximates else ""
+    return f"""DEF cell(rSpeed:IN)
+DECL REAL rSpeed
+$TOOL = $NULLFRAME
+$BASE = $NULLFRAME
+$VEL.CP = 0.2
+PDAT_ACT = {{VEL 100, ACC 100, APO_DIST 5}}
+BAS(#PTP_DAT)
+PTP {{A1 0, A2 -90, A3 90, A4 0, A5 45, A6 0}}
+LIN {{X 500, Y 0, Z 600, A 0, B 90, C 0}}{first}
+$VEL.CP = rSpeed
+LIN {{X 500, Y 0, Z 650, A 0, B 90, C 0}} C_DIS
+LIN {{X 500, Y 0, Z 700, A 0, B 90, C 0}}
+END
+"""
+
+
+@pytest.mark.parametrize("first_approximates", [True, False])
+def test_an_approximation_keeps_its_words_only_where_its_distance_is_on_the_controller(
+    tmp_path: Path, first_approximates: bool
+) -> None:
+    """The LIN after a run-time ``$VEL.CP`` runs with the controller's settings and keeps its
+    C_DIS where the output wrote the program's ``$APO.CDIS`` before (an approximated LIN did);
+    where no motion wrote it and no statement that sets it can be kept any more, the controller
+    would approximate with another distance, so the motion is an exact stop with a note."""
+    src = tmp_path / "cell.src"
+    src.write_text(_distance_program(first_approximates))
+    result = olp.build(olp.load_station(STATION), src, post="kuka", collisions=None)
+    assert result.ok, [d.format() for d in result.diagnostics if d.severity == "error"]
+    (move, _) = [n for n in result.compiled.program.instructions if isinstance(n, ir.RuntimeMove)]
+    assert move.approximated == (("C_DIS",) if first_approximates else ())
+    noted = [d for d in result.diagnostics if "written as an exact stop" in d.message]
+    assert len(noted) == (0 if first_approximates else 1)

@@ -291,12 +291,14 @@ class _Lowering(Motions, Events):
         runs with the ones olp knows: each must be on the controller. One olp absorbed and
         wrote only where a motion used it, which no motion of this kind has since
         (``$ORI_TYPE = #CONSTANT`` before a PTP: the output writes it before a CIRC only), is
-        not: an error, not a motion run with another value. An approximated one's distance is
-        one of them (the motion keeps its C_DIS: :attr:`olp.ir.RuntimeMove.approximated`)."""
+        not: an error, not a motion run with another value. (An approximation distance is not
+        one: where the output has not put the program's on the controller, the motion is written
+        as an exact stop, :meth:`_controller_settings_motion`.)"""
         joint = motion.keyword.upper().startswith(("PTP", "SPTP"))
         names = []
         # (the parts of the speed held apart are the speed's and the axis settings' keys)
-        for name in sorted(self._used_settings(motion) - set(unsettled) - set(PART_KEYS)):
+        used = self._used_settings(motion) - set(unsettled) - set(PART_KEYS) - {"cdis_mm"}
+        for name in sorted(used):
             keys = FIELD_KEYS[name]
             if name == "speed":
                 keys = frozenset({"speed.joint" if joint else "speed.linear"})

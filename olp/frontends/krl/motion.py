@@ -436,6 +436,17 @@ class Motions(InlineForms):
             "(olp writes none before it)"
         )
         why = "; ".join(sorted(set(unsettled.values())))
+        approximated = tuple(word.upper() for word in stmt.approx)
+        unkeepable: Callable[[], set[str]] | None = getattr(self, "unkeepable", None)
+        if approximated and "cdis_mm" not in unsettled and unkeepable and "cdis_mm" in unkeepable():
+            self._note(
+                stmt.span,
+                f"{' '.join(stmt.approx)} with the controller's settings: the $APO.CDIS the "
+                "program set is not on the controller here (olp writes it only before a motion "
+                "that approximates with it), so the controller would approximate with another "
+                "distance; written as an exact stop",
+            )
+            approximated = ()
         self.out.append(
             ir.RuntimeMove(
                 motion=_RUNTIME_KINDS[base],
@@ -445,7 +456,7 @@ class Motions(InlineForms):
                 controller_settings=True,
                 spline=stmt.keyword.upper() in _SPLINE_MOTIONS,
                 relative=relative,
-                approximated=tuple(word.upper() for word in stmt.approx),
+                approximated=approximated,
                 span=stmt.span,
             )
         )
