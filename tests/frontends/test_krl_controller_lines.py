@@ -130,15 +130,21 @@ def test_another_post_stops_on_the_timer_naming_its_line(station: object, tmp_pa
 
 def test_an_input_is_never_set() -> None:
     """The controller sets its inputs: an assignment to one (a SIGNAL of an input, or $IN[n])
-    is left out with a warning, as before; olp does not know whether the KRL compiler
-    refuses it, so it does not stop."""
+    models nothing. It is kept as written for the KRL post (KRL to KRL keeps every statement;
+    it used to be left out), with a warning; olp does not know whether the KRL compiler
+    refuses it, so it does not stop. Another post leaves it out with a warning."""
     text = "DEF io( )\nSIGNAL bStart $IN[3]\nbStart = FALSE\n$IN[4] = TRUE\nEND\n"
     result = parse_krl(text, "io.src")
-    kept = [n.text for n in result.program if isinstance(n, ir.Verbatim)]
-    assert kept == ["SIGNAL bStart $IN[3]"]  # the declaration, for the KRL post
-    assert [(i.span.line, i.reason) for i in result.ignored] == [
-        (3, "bStart is an input ($IN) and cannot be set"),
-        (4, "$IN is an input ($IN) and cannot be set"),
+    kept = [(n.text, n.native_only) for n in result.program if isinstance(n, ir.Verbatim)]
+    assert kept == [
+        ("SIGNAL bStart $IN[3]", True),
+        ("bStart = FALSE", True),
+        ("$IN[4] = TRUE", True),
+    ]
+    assert result.ignored == ()
+    assert [(n.span.line, n.message.split(":")[0]) for n in result.notes] == [
+        (3, "bStart is an input ($IN) and cannot be set by the program"),
+        (4, "$IN is an input ($IN) and cannot be set by the program"),
     ]
 
 

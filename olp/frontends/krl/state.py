@@ -293,8 +293,10 @@ TIMING_NOTES = {
 """What a kept system variable does to olp's figures, said once per program (keys as
 :attr:`Var.key`)."""
 INPUT_ASSIGNMENT = "is an input ({io}) and cannot be set"
-"""Why an assignment to an input is left out (with a warning): the controller sets inputs.
-Whether the KRL compiler refuses it is not verified, so olp does not stop on it."""
+"""Why an assignment to an input means nothing olp models: the controller sets inputs. It is
+kept as written for the KRL post (KRL to KRL keeps every statement, and the controller then
+decides as it did for the source) with a warning; whether the KRL compiler refuses it is not
+verified, so olp does not stop on it (:meth:`Core._input_assignment`)."""
 SYSTEM_REASONS = {
     **SYSTEM_REASONS,
     "$ACC.ORI1": "orientation acceleration ($ACC.ORI1) is not part of olp's IR",
@@ -730,7 +732,9 @@ class Core:
             setter(key, stmt.value, stmt)
         elif key in KEPT_SYSTEM_VARIABLES:
             self._keep_system(stmt, key)
-        elif key in SYSTEM_REASONS:  # $BWDSTART, an input ($IN[n] = ...), $CIRC_MODE
+        elif key == "$IN[]":
+            self._input_assignment(stmt, "$IN")
+        elif key in SYSTEM_REASONS:  # $BWDSTART, $CIRC_MODE
             self._ignore(stmt, SYSTEM_REASONS[key])
         elif key.startswith("$"):
             # a timer, a flag, a message text, torque monitoring: it changes what the program
@@ -971,6 +975,20 @@ class Core:
             ir.SetOutput(index=index, value=constant.value, signal=signal, span=stmt.span)
         )
 
+    def _input_assignment(self, stmt: Assign, io: str) -> None:
+        """An assignment to an input (``bStart = FALSE`` of ``SIGNAL bStart $IN[3]``, or
+        ``$IN[4] = TRUE``): the controller sets its inputs, so it changes nothing olp models.
+        Kept as written for the KRL post, with a warning; another post leaves it out with one
+        (:attr:`olp.ir.Verbatim.native_only`)."""
+        what = f"{stmt.target.name} {INPUT_ASSIGNMENT.format(io=io)}"
+        self._keep_krl_only(stmt, f"{what}: it means something only on a KUKA controller")
+        self._note(
+            stmt.span,
+            f"{what} by the program: kept as written for the KRL output, as the source has it "
+            "(olp has not verified whether the controller accepts a program that assigns an "
+            "input; it models nothing of it)",
+        )
+
     def _is_signal(self, target: Var) -> bool:
         return not target.selectors and isinstance(self._value(target), Signal)
 
@@ -978,7 +996,7 @@ class Core:
         signal = self._value(stmt.target)
         assert isinstance(signal, Signal)
         if signal.io != "$OUT":
-            self._ignore(stmt, f"{stmt.target.name} {INPUT_ASSIGNMENT.format(io=signal.io)}")
+            self._input_assignment(stmt, signal.io)
             return
         self._output(signal.index, stmt.value, stmt, self._signal_name(stmt.target, signal))
 
