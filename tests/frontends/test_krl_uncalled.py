@@ -181,3 +181,34 @@ def test_a_routine_each_call_runs_with_the_controller_s_settings_is_one_routine(
     assert "at each of its calls (lines 5, 7)" in lin.reason
     lines = [line.strip() for line in result.files["cell.src"].splitlines()]
     assert lines.count("Place()") == 2 and lines.count("DEF Place()") == 1
+
+
+SIGNALS = """DEF cell( )
+PTP {A1 0, A2 -90, A3 90, A4 0, A5 45, A6 0}
+END
+
+GLOBAL DEF ResetPanel( )
+bLamp = FALSE
+bStart = FALSE
+END
+"""
+
+SIGNALS_DAT = "DEFDAT cell\nSIGNAL bLamp $OUT[7]\nSIGNAL bStart $IN[3]\nENDDAT\n"
+
+
+@pytest.mark.parametrize("post", ["kuka", "abb"])
+def test_a_signal_the_module_switches_stays_a_signal_where_an_unknown_caller_enters(
+    tmp_path: Path, post: str
+) -> None:
+    """A module's variables that it assigns are run-time values in a routine no call runs;
+    a SIGNAL is no variable: ``bLamp = FALSE`` stays an output switched (every post writes
+    it), ``bStart = FALSE`` an assignment to an input (KRL only, with a warning). A signal
+    taken as a run-time variable made RAPID refuse an undeclared name."""
+    src = tmp_path / "cell.src"
+    src.write_text(SIGNALS)
+    (tmp_path / "cell.dat").write_text(SIGNALS_DAT)
+    result = olp.build(olp.load_station(STATION), src, post=post, collisions=None)
+    assert result.ok, [d.format() for d in result.diagnostics if d.severity == "error"]
+    (routine,) = result.compiled.program.routines
+    kinds = [(n.kind, n.span.line) for n in routine.body if n.kind != "comment"]
+    assert kinds == [("set_output", 6), ("verbatim", 7)]

@@ -1693,7 +1693,8 @@ def _entry_values(values: dict[str, Value], module: Sequence[Routine]) -> dict[s
     controller's settings, :func:`_entered_at_calls`):
     their declared (data-list) values where nothing in the module assigns them, else known only
     when the program runs (another routine, an earlier run of this one, or a routine olp did
-    not read given it by reference may have changed it)."""
+    not read given it by reference may have changed it). A SIGNAL stays one: it names an input
+    or output, which an assignment switches (or, an input, cannot), never a value."""
     assigned: set[str] = set()
     for routine in module:
         assigned |= assigned_names(routine.body) | set(_passed(routine.body))
@@ -1702,7 +1703,7 @@ def _entry_values(values: dict[str, Value], module: Sequence[Routine]) -> dict[s
             f"{name} is assigned in the module: where a caller olp does not follow enters a "
             "routine, its value is known only when the program runs"
         )
-        if name in assigned
+        if name in assigned and not isinstance(value, Signal)
         else value
         for name, value in values.items()
     }
