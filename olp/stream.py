@@ -234,6 +234,8 @@ def build_streamed(
         with CsvWindows(path, program_options, station, rows) as windows:
             findings.add(ignored_notes(windows.ignored))
             program_name = name or windows.name
+            asked = Program(name=windows.name, instructions=(), source=str(path))
+            findings.add(post.renamed(asked, name))
             from olp.posts.stream import StreamedRender
 
             planned = None

@@ -292,3 +292,15 @@ def test_progress_shows_the_build_and_each_stage_with_its_rate(
     assert any(line.startswith("build") and "rows/s" in line for line in lines)
     for stage in ("read", "resolve", "collide", "time", "write"):
         assert any(line.split()[:1] == [stage] and "3,000 rows in" in line for line in lines)
+
+
+def test_a_streamed_program_renamed_to_fit_the_language_is_a_warning_as_a_whole_one(
+    station: olp.Station, tmp_path: Path
+) -> None:
+    """A KRL module name has at most 24 characters: the streamed build, like the whole one,
+    says that it writes the program under a shorter name (other modules call it by name)."""
+    csv = helix_csv(tmp_path / "helix_toolpath_for_the_second_fixture.csv", 12_000)
+    results = both(station, csv, tmp_path)
+    for result in results:
+        (renamed,) = [d for d in result.diagnostics if d.kind == "renamed"]
+        assert "written as helix_toolpath_for_the_s:" in renamed.message
