@@ -472,7 +472,7 @@ FILTERS: Mapping[str, Filter] = {
     "krl_param_decl": lambda post, param: krl_param_decl(param),
     "krl_call": lambda post, call: krl_call(call),
     "krl_return": lambda post, node: krl_return(node),
-    "krl_approximation": lambda post, words: krl_approximation(words),
+    "krl_approximation": lambda post, move: krl_approximation(move),
 }
 
 

@@ -24,6 +24,7 @@ from olp import ir
 from olp.errors import PostError
 from olp.ir_flow import sub_expressions
 from olp.posts.sandbox import SafeText, unsafe_character
+from olp.vendors.kuka import approximation_problem
 
 _BINARY = {
     "and": "AND",
@@ -228,19 +229,18 @@ def krl_call(call: ir.RoutineCall) -> str:
     return f"{call.name}({', '.join(krl_expr(a) for a in call.args)})"
 
 
-KRL_APPROXIMATION = frozenset({"C_PTP", "C_DIS", "C_VEL", "C_ORI", "C_SPL"})
-"""The approximation words of a KRL motion (KSS 8 programming manual, PTP/LIN/CIRC and the
-spline motions; olp's grammar reads the same five)."""
-
-
-def krl_approximation(words: tuple[str, ...]) -> str:
+def krl_approximation(move: ir.RuntimeMove) -> str:
     """`` C_PTP C_DIS``: the approximation words of a motion that runs with the controller's
-    settings (:attr:`olp.ir.RuntimeMove.approximated`), with the blank before them; a word KRL
-    does not have is a PostError (an IR made elsewhere), never written."""
-    unknown = [w for w in words if w.upper() not in KRL_APPROXIMATION]
-    if unknown:
-        raise PostError(f"the KRL post has no approximation {unknown[0]!r}")
-    return "".join(f" {w.upper()}" for w in words)
+    settings (:attr:`olp.ir.RuntimeMove.approximated`), with the blank before them. Words KRL
+    does not take for that motion (:func:`olp.vendors.kuka.approximation_problem`; an IR made
+    elsewhere) are a PostError, never written."""
+    words = tuple(w.upper() for w in move.approximated)
+    problem = approximation_problem(words, move.motion == "joint", move.spline)
+    if problem is not None:
+        raise PostError(
+            f"the KRL post cannot write the approximation {' '.join(words)!r}: {problem}"
+        )
+    return "".join(f" {w}" for w in words)
 
 
 def krl_return(node: ir.Return) -> str:

@@ -63,3 +63,10 @@ def test_the_warning_says_what_the_output_writes(station: object, tmp_path: obje
     assert "$TOOL = $NULLFRAME" in text and "$BASE = $NULLFRAME" in text
     warned = [d for d in result.diagnostics if "before any $TOOL" in d.message]
     assert len(warned) == 1 and warned[0].severity == "warning"
+
+
+def test_a_tool_given_in_a_with_is_that_motions_only() -> None:
+    """A WITH's $TOOL holds for its motion only: the plain LIN after it still runs with the
+    controller's tool in the source, so it gets the warning."""
+    spline = "SLIN {X 500,Y 0,Z 650,A 0,B 90,C 0} WITH $TOOL = {X 0,Y 0,Z 120,A 0,B 0,C 0}"
+    assert notes_on("$BASE = $NULLFRAME", spline, LIN) == [(5, "LIN before any $TOOL")]

@@ -210,13 +210,36 @@ def test_approximation_words_are_checked_when_made(fields: dict, problem: str) -
         ir.RuntimeMove(motion="linear", target=ir.Name(name="xP1"), **fields)
 
 
-def test_the_krl_post_writes_only_krls_approximation_words() -> None:
+@pytest.mark.parametrize(
+    ("motion", "spline", "words", "written"),
+    [
+        ("joint", False, ("c_ptp", "C_DIS"), " C_PTP C_DIS"),
+        ("linear", False, ("C_DIS",), " C_DIS"),
+        ("linear", True, ("C_SPL",), " C_SPL"),
+        ("linear", False, ("C_FAST",), None),
+        ("linear", False, ("C_PTP",), None),  # a LIN has no C_PTP
+        ("joint", False, ("C_PTP", "C_PTP"), None),
+        ("linear", False, ("C_SPL",), None),  # C_SPL is a spline motion's
+    ],
+)
+def test_the_krl_post_writes_only_the_approximation_krl_takes_for_the_motion(
+    motion: str, spline: bool, words: tuple[str, ...], written: str | None
+) -> None:
     from olp.errors import PostError
     from olp.posts.kuka_flow import krl_approximation
 
-    assert krl_approximation(("c_ptp", "C_DIS")) == " C_PTP C_DIS"
-    with pytest.raises(PostError, match="C_FAST"):
-        krl_approximation(("C_FAST",))
+    move = ir.RuntimeMove(
+        motion=motion,  # type: ignore[arg-type]
+        target=ir.Name(name="xP1"),
+        controller_settings=True,
+        approximated=words,
+        spline=spline,
+    )
+    if written is None:
+        with pytest.raises(PostError, match="cannot write the approximation"):
+            krl_approximation(move)
+    else:
+        assert krl_approximation(move) == written
 
 
 def _distance_program(first_approximates: bool) -> str:

@@ -46,7 +46,12 @@ from olp.frontends.krl.values import (
     Unknown,
     is_axis_aggregate,
 )
-from olp.vendors.kuka import configuration_from_status_turn, frame_to_pose, pose_to_frame
+from olp.vendors.kuka import (
+    approximation_problem,
+    configuration_from_status_turn,
+    frame_to_pose,
+    pose_to_frame,
+)
 
 _BASE_MOTION = {
     "PTP": "PTP",
@@ -63,8 +68,6 @@ _BASE_MOTION = {
     "SCIRC_REL": "CIRC",
 }
 _SPLINE_MOTIONS = frozenset({"SPTP", "SLIN", "SCIRC", "SPTP_REL", "SLIN_REL", "SCIRC_REL"})
-_CP_APPROX = ("C_DIS", "C_VEL", "C_ORI")
-_ONE_CP_APPROX = frozenset((a,) for a in _CP_APPROX)
 _PTP_APPROX = frozenset({("C_PTP",), ("C_PTP", "C_DIS"), ("C_DIS",)})
 _LIN_APPROX = frozenset({("C_DIS",), ("C_DIS", "C_DIS")})
 _FAST_KEYWORDS = {"PTP": "PTP", "SPTP": "PTP", "LIN": "LIN", "SLIN": "LIN"}
@@ -776,25 +779,9 @@ class Motions(InlineForms):
         C_SPL: the $APO.CDIS distance. (The KSS manual was not at hand to confirm it.)"""
         approx = stmt.approx
         spline = stmt.keyword in _SPLINE_MOTIONS
-        if spline and approx in (("C_SPL",), ("C_DIS",)):
-            return
-        if base == "PTP":
-            # KSS 8.2 and later: the PTP inline form with CONT writes PTP XP1 C_DIS, the
-            # distance criterion ($APO.CDIS) instead of $APO.CPTP.
-            valid = approx == ("C_DIS",) or (
-                approx[0] == "C_PTP" and (len(approx) == 1 or approx[1:] in _ONE_CP_APPROX)
-            )
-            rule = (
-                "PTP approximates with C_DIS, or with C_PTP optionally followed by C_DIS, "
-                "C_ORI or C_VEL"
-            )
-        else:
-            # The inline forms of KSS 8 write the keyword twice: LIN XP1 C_DIS C_DIS.
-            doubled = len(approx) == 2 and approx[0] == approx[1]
-            valid = approx in _ONE_CP_APPROX or (doubled and approx[:1] in _ONE_CP_APPROX)
-            rule = f"{stmt.keyword} approximates with one of C_DIS, C_ORI or C_VEL"
-        if not valid:
-            rule += "; spline motions with C_SPL" if spline else ""
+        problem = approximation_problem(approx, base == "PTP", spline)
+        if problem is not None:
+            rule = problem.replace("a LIN or CIRC", stmt.keyword, 1)
             raise self._error(f"invalid approximation {' '.join(approx)!r}: {rule}", stmt.span)
 
     # ---- targets
@@ -952,6 +939,7 @@ class Motions(InlineForms):
         target is known only at run time (then a :class:`~olp.ir.RuntimeMove`), or None."""
         saved = self.state
         ambiguous = dict(getattr(self, "ambiguous", {}))  # the WITH's values are this motion's
+        unset = set(getattr(self, "unset", set()))  # a WITH's tool is not the program's
         self.in_with = True  # a $BASE or $TOOL set from a run-time value cannot be kept here
         try:
             for assignment in stmt.with_clause:
@@ -966,6 +954,8 @@ class Motions(InlineForms):
         self.state = saved
         if hasattr(self, "ambiguous"):
             self.ambiguous = ambiguous
+        if hasattr(self, "unset"):
+            self.unset = unset
         if (during.tool, during.frame) != (saved.tool, saved.frame):
             line = stmt.span.line
             self.track.lose_cartesian(f"the WITH at line {line} set $TOOL/$BASE for that motion")
