@@ -195,19 +195,21 @@ _CP_APPROX = frozenset({("C_DIS",), ("C_VEL",), ("C_ORI",)})
 
 
 def approximation_problem(words: tuple[str, ...], joint: bool, spline: bool) -> str | None:
-    """Why ``words`` (upper case) are not a KRL motion's approximation, else None: a PTP
-    approximates with C_DIS, or C_PTP optionally followed by C_DIS, C_ORI or C_VEL; a LIN or
-    CIRC with one of C_DIS, C_ORI or C_VEL (the inline forms of KSS 8 write it twice: ``LIN
-    XP1 C_DIS C_DIS``); a spline motion with C_SPL, and an SPTP/SLIN/SCIRC also with C_DIS,
-    which real KR C4 programs write and olp reads as C_SPL. Source: KUKA's KSS 8 motion syntax
-    as olp's KRL grammar reads it, and the public controller backups of
-    benchmarks/krl_corpus.py; not checked against the KSS manual here."""
+    """Why ``words`` (upper case) are not a KRL motion's approximation, else None.
+
+    A PTP approximates with C_DIS, or C_PTP optionally followed by C_DIS, C_ORI or C_VEL; a LIN
+    or CIRC with one of C_DIS, C_ORI or C_VEL. The inline forms of KSS 8 write the keyword
+    twice (``LIN XP1 C_DIS C_DIS``), and ``PTP XP1 C_DIS C_DIS`` is read the same way. A
+    spline motion approximates with C_SPL; an SPTP/SLIN/SCIRC also takes C_DIS, which real
+    KR C4 programs write and olp reads as C_SPL. Source: KUKA's KSS 8 motion syntax as olp's
+    KRL grammar reads it, and the public controller backups of benchmarks/krl_corpus.py; not
+    checked against the KSS manual here."""
     if not words:
         return None
     if spline and words in (("C_SPL",), ("C_DIS",)):
         return None
     if joint:
-        valid = words == ("C_DIS",) or (
+        valid = words in (("C_DIS",), ("C_DIS", "C_DIS")) or (
             words[0] == "C_PTP" and (len(words) == 1 or words[1:] in _CP_APPROX)
         )
         rule = (

@@ -279,3 +279,25 @@ def test_an_approximation_keeps_its_words_only_where_its_distance_is_on_the_cont
     assert move.approximated == (("C_DIS",) if first_approximates else ())
     noted = [d for d in result.diagnostics if "written as an exact stop" in d.message]
     assert len(noted) == (0 if first_approximates else 1)
+
+
+def test_an_approximation_krl_does_not_take_is_a_located_error_after_an_unread_call(
+    tmp_path: Path,
+) -> None:
+    """A motion with the controller's settings has its approximation checked like a modelled
+    one's: a located error at its line, never a PostError without one when it is written."""
+    text = APPROXIMATED.replace("} c_dis\n", "} C_PTP\n")
+    with pytest.raises(ParseError, match="invalid approximation 'C_PTP'") as err:
+        _build(tmp_path, text)
+    assert err.value.span is not None and err.value.span.line == 6
+
+
+def test_a_ptp_approximated_with_c_dis_written_twice_is_kept(tmp_path: Path) -> None:
+    """``PTP x C_DIS C_DIS`` (the doubled keyword of the inline forms, as for a LIN) is read
+    and written back as it stands."""
+    text = APPROXIMATED.replace("} C_PTP C_DIS\n", "} C_DIS C_DIS\n")
+    src = tmp_path / "cell.src"
+    src.write_text(text)
+    result = olp.build(olp.load_station(STATION), src, post="kuka", collisions=None)
+    assert result.ok, [d.format() for d in result.diagnostics if d.severity == "error"]
+    assert "PTP {A1 10, A2 -90, A3 90, A4 0, A5 45, A6 0} C_DIS C_DIS" in result.files["cell.src"]

@@ -439,6 +439,8 @@ class Motions(InlineForms):
             "(olp writes none before it)"
         )
         why = "; ".join(sorted(set(unsettled.values())))
+        if stmt.approx:
+            self._check_approx(stmt, base)  # (a modelled motion's is checked by _zone)
         approximated = tuple(word.upper() for word in stmt.approx)
         unkeepable: Callable[[], set[str]] | None = getattr(self, "unkeepable", None)
         if approximated and "cdis_mm" not in unsettled and unkeepable and "cdis_mm" in unkeepable():
