@@ -68,6 +68,8 @@ _BASE_MOTION = {
     "SCIRC_REL": "CIRC",
 }
 _SPLINE_MOTIONS = frozenset({"SPTP", "SLIN", "SCIRC", "SPTP_REL", "SLIN_REL", "SCIRC_REL"})
+# The approximations the fast path lowers without a note (a subset of what KRL takes,
+# olp.vendors.kuka.approximation_problem; any other goes through _motion and its check).
 _PTP_APPROX = frozenset({("C_PTP",), ("C_PTP", "C_DIS"), ("C_DIS",)})
 _LIN_APPROX = frozenset({("C_DIS",), ("C_DIS", "C_DIS")})
 _FAST_KEYWORDS = {"PTP": "PTP", "SPTP": "PTP", "LIN": "LIN", "SLIN": "LIN"}
